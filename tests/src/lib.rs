@@ -1,0 +1,1 @@
+//! Scenario-based and property tests live in `tests/tests/`.
