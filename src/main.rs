@@ -1,1 +1,17 @@
-fn main() {}
+//! `groundtruth`: LiDAR ground truth on demand. Scans procedural scenes with real sensor models,
+//! writes labelled ordered clouds, classifies ground points and evaluates the result.
+
+mod cli;
+
+use clap::Parser;
+
+fn main() -> std::process::ExitCode {
+    let args = cli::Cli::parse();
+    match cli::run(args) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

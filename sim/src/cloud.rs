@@ -1,0 +1,125 @@
+//! The ordered labelled cloud: a rows x columns grid per frame in which every cell, return or not,
+//! carries its ring, column, sensor and time, and returns carry position, range, intensity, echo,
+//! labels and the true surface normal.
+//!
+//! Storage is one array per field (structure of arrays), index `(plane * rows + row) * cols + col`.
+//! Plane 0 holds each shot's first echo; planes 1.. hold second and third echoes where the sensor
+//! reports them (multi-echo LUX), so `planes == 1` for most sensors.
+
+use glam::Vec3;
+
+use crate::scene::SemanticClass;
+
+/// One frame of an ordered, labelled LiDAR cloud.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct OrderedCloud {
+    /// Grid rows (rings, sorted by elevation, row 0 lowest).
+    pub rows: usize,
+    /// Grid columns (sorted by azimuth, column 0 left-most).
+    pub cols: usize,
+    /// Echo planes (1 unless the sensor reports multiple echoes).
+    pub planes: usize,
+    /// Position in the vehicle frame at the frame's reference time, metres; NaN where no return.
+    pub point_in_vehicle: Vec<Vec3>,
+    /// Measured range from the beam origin, metres; NaN where no return.
+    pub range_m: Vec<f32>,
+    /// Intensity in `[0, 1]`; 0 where no return.
+    pub intensity: Vec<f32>,
+    /// The sensor's own ring (layer, laser) index of the cell.
+    pub ring: Vec<u16>,
+    /// The sensor's own column index of the cell.
+    pub column: Vec<u32>,
+    /// Sensor id (index into the rig); `u8::MAX` where no sensor covers the cell.
+    pub sensor: Vec<u8>,
+    /// Shot time, seconds since the start of the scan (frame `k` starts at `k * period`).
+    pub time_s: Vec<f64>,
+    /// Echo number of the return (0 = first); 0 where no return.
+    pub echo: Vec<u8>,
+    /// Semantic class of the surface hit; 0 (unlabeled) where no return.
+    pub label: Vec<SemanticClass>,
+    /// Instance id of the surface hit; 0 for stuff and where no return.
+    pub instance: Vec<u32>,
+    /// Ground truth: whether the surface hit is ground.
+    pub ground: Vec<bool>,
+    /// True surface normal at the hit, vehicle frame, unit; zero where no return.
+    pub normal: Vec<Vec3>,
+}
+
+impl OrderedCloud {
+    /// A grid of `planes * rows * cols` no-return cells (sensor `u8::MAX`, time 0).
+    pub fn empty(rows: usize, cols: usize, planes: usize) -> Self {
+        let n = rows * cols * planes;
+        Self {
+            rows,
+            cols,
+            planes,
+            point_in_vehicle: vec![Vec3::NAN; n],
+            range_m: vec![f32::NAN; n],
+            intensity: vec![0.0; n],
+            ring: vec![0; n],
+            column: vec![0; n],
+            sensor: vec![u8::MAX; n],
+            time_s: vec![0.0; n],
+            echo: vec![0; n],
+            label: vec![SemanticClass::UNLABELED; n],
+            instance: vec![0; n],
+            ground: vec![false; n],
+            normal: vec![Vec3::ZERO; n],
+        }
+    }
+
+    /// Number of cells (`planes * rows * cols`).
+    pub fn len(&self) -> usize {
+        self.point_in_vehicle.len()
+    }
+
+    /// Whether the grid has no cells.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Cell index of `(plane, row, col)`.
+    pub fn index(&self, plane: usize, row: usize, col: usize) -> usize {
+        (plane * self.rows + row) * self.cols + col
+    }
+
+    /// Whether cell `i` holds a return.
+    pub fn has_return(&self, i: usize) -> bool {
+        self.range_m[i].is_finite()
+    }
+
+    /// Number of cells with a return.
+    pub fn returns(&self) -> usize {
+        self.range_m.iter().filter(|r| r.is_finite()).count()
+    }
+
+    /// Number of returns on ground.
+    pub fn ground_returns(&self) -> usize {
+        (0..self.len()).filter(|&i| self.has_return(i) && self.ground[i]).count()
+    }
+
+    /// Checks that every field has `planes * rows * cols` entries.
+    pub fn check_consistent(&self) -> Result<(), String> {
+        let n = self.rows * self.cols * self.planes;
+        let lens = [
+            ("point_in_vehicle", self.point_in_vehicle.len()),
+            ("range_m", self.range_m.len()),
+            ("intensity", self.intensity.len()),
+            ("ring", self.ring.len()),
+            ("column", self.column.len()),
+            ("sensor", self.sensor.len()),
+            ("time_s", self.time_s.len()),
+            ("echo", self.echo.len()),
+            ("label", self.label.len()),
+            ("instance", self.instance.len()),
+            ("ground", self.ground.len()),
+            ("normal", self.normal.len()),
+        ];
+        for (name, len) in lens {
+            if len != n {
+                return Err(format!("field `{name}` has {len} entries, grid {}x{}x{} needs {n}", self.planes, self.rows, self.cols));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,1 @@
+//! PLY mesh export/import. TODO

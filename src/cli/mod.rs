@@ -1,0 +1,52 @@
+//! Command-line interface: one module per subcommand.
+
+mod bench;
+mod classify;
+mod eval;
+mod list;
+mod render;
+mod scan;
+mod scene;
+
+use clap::{Parser, Subcommand};
+
+/// LiDAR ground truth on demand: scan procedural scenes, classify ground, evaluate.
+#[derive(Parser, Debug)]
+#[command(name = "groundtruth", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// List the scenes, rigs and classification methods this build knows.
+    List(list::Args),
+    /// Scan a scene with a rig and write ordered labelled clouds and a manifest.
+    Scan(scan::Args),
+    /// Scene tools (export a scene mesh).
+    #[command(subcommand)]
+    Scene(scene::Command),
+    /// Draw a scene from above, or a scan as a bird's-eye view or range image (PNG).
+    Render(render::Args),
+    /// Classify ground points in scanned clouds.
+    Classify(classify::Args),
+    /// Scan, classify and score methods on a scene (Table I style).
+    Eval(eval::Args),
+    /// Benchmarks that print one JSON object.
+    #[command(subcommand)]
+    Bench(bench::Command),
+}
+
+/// Runs the parsed command.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::List(a) => list::run(a),
+        Command::Scan(a) => scan::run(a),
+        Command::Scene(c) => scene::run(c),
+        Command::Render(a) => render::run(a),
+        Command::Classify(a) => classify::run(a),
+        Command::Eval(a) => eval::run(a),
+        Command::Bench(c) => bench::run(c),
+    }
+}
