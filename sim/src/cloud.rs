@@ -117,7 +117,10 @@ impl OrderedCloud {
         ];
         for (name, len) in lens {
             if len != n {
-                return Err(format!("field `{name}` has {len} entries, grid {}x{}x{} needs {n}", self.planes, self.rows, self.cols));
+                return Err(format!(
+                    "field `{name}` has {len} entries, grid {}x{}x{} needs {n}",
+                    self.planes, self.rows, self.cols
+                ));
             }
         }
         Ok(())

@@ -1,10 +1,14 @@
 //! Command-line interface: one module per subcommand.
 
 mod bench;
+mod bench_classify;
 mod classify;
+mod common;
 mod eval;
 mod list;
 mod render;
+mod render_scan;
+mod render_scene;
 mod scan;
 mod scene;
 

@@ -1,3 +1,4 @@
-//! Files: atomic writes, the scan manifest, and point-cloud formats. TODO(io helper): formats.
+//! Files: atomic writes, the scan manifest, and point-cloud formats.
 
 pub mod atomic;
+pub mod formats;
