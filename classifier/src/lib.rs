@@ -1,1 +1,30 @@
-//! classifier
+//! `classifier`: ground point classification on ordered LiDAR clouds after Nitsch et al.,
+//! *3D Ground Point Classification for Automotive Scenarios*, with the baselines of its Table I
+//! and the metrics to compare them.
+//!
+//! Data flow: an [`sim::OrderedCloud`] -> [`neighbours`] (the 8-neighbourhood of Fig. 3 on the grid)
+//! -> [`features`] (`n`, `n_rho`, `g_rho`, Eq. 1-4) -> [`cluster`] (conditional Euclidean clustering
+//! and the cluster rules of Sec. III-B) -> a ground decision per cell ([`nitsch`]). The baselines
+//! ([`baselines::ransac`], [`baselines::grid`]) and the method live behind one trait in
+//! [`methods`], chosen by name from [`METHODS`]. [`metrics`] scores decisions against ground truth;
+//! [`ordering`] turns unordered clouds (KITTI `.bin`) into grids; [`synthetic`] builds analytic test
+//! clouds.
+//!
+//! Decisions are one `bool` per cell of the cloud, in the cloud's grid order over all echo planes;
+//! cells without a return are never ground.
+
+pub mod baselines;
+pub mod cluster;
+pub mod error;
+pub mod features;
+pub mod methods;
+pub mod metrics;
+pub mod neighbours;
+pub mod nitsch;
+pub mod ordering;
+pub mod synthetic;
+
+pub use error::{ClassifyError, Result};
+pub use methods::{FrameInput, GroundClassifier, METHODS, method_by_name};
+pub use metrics::{Confusion, Evaluation, Scores};
+pub use nitsch::{Nitsch, NitschParams};

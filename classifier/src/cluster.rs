@@ -1,0 +1,275 @@
+//! Conditional Euclidean clustering of ground candidates on the grid, and the cluster rules of
+//! Nitsch et al. Sec. III-B that decide which clusters are ground.
+//!
+//! Clustering (decision): PCL's conditional Euclidean clustering joins two points when they are
+//! within a radius and a condition holds. Here the radius search uses the grid's own adjacency
+//! (the 8-neighbourhood of [`crate::neighbours`]) instead of a k-d tree: two candidates join when
+//! they are grid neighbours and their distance is at most `link_tolerance_m + link_tolerance_rel *
+//! max(|p_a|, |p_b|)` (distances from the vehicle origin; the spacing of scan points grows with
+//! range, so a fixed radius would cut far ground into rings). The condition is that both are
+//! candidates (`g_rho >= threshold`). On a surface sampled by the grid, every pair of candidates
+//! within the radius is connected through a chain of grid neighbours, so the partition equals the
+//! k-d tree's (tested against a brute-force radius clustering); the two differ only across gaps of
+//! empty cells wider than the neighbour search, where the grid version does not join.
+//!
+//! Rules (Sec. III-B), in order:
+//! 1. clusters with fewer than `min_cluster_points` points are noise: not ground;
+//! 2. the largest cluster is ground;
+//! 3. a cluster inside the ground cluster's area is not ground (a car roof) when it lies more than
+//!    `max_step_m` above the ground cluster there; one at the ground's height is ground (a patch cut
+//!    off by an occluder or a kerb). The area is the set of `area_cell_m` squares in the x-y plane
+//!    that hold ground-cluster points; a point is inside when one of the 3 x 3 squares around it
+//!    does, and a cluster is inside when at least half its points are;
+//! 4. a cluster outside the area is ground when it is large (at least `min_large_points` points, or
+//!    `min_large_fraction` of the plane's returns if that is more: terrain beyond a basin, another
+//!    floor), otherwise not.
+
+use glam::Vec3;
+
+use crate::error::{ClassifyError, Result, is_valid};
+use crate::neighbours::GridView;
+
+/// Parameters of clustering and of the cluster rules.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClusterParams {
+    /// Fixed part of the link radius, metres.
+    pub link_tolerance_m: f32,
+    /// Range-proportional part of the link radius (per metre of range).
+    pub link_tolerance_rel: f32,
+    /// Clusters smaller than this are noise.
+    pub min_cluster_points: usize,
+    /// Clusters outside the ground area with at least this many points are ground.
+    pub min_large_points: usize,
+    /// ... or at least this fraction of the returns, whichever is more.
+    pub min_large_fraction: f32,
+    /// Side of the squares of the ground area, metres.
+    pub area_cell_m: f32,
+    /// Height above the local ground cluster beyond which an inside cluster is an object, metres.
+    pub max_step_m: f32,
+}
+
+impl Default for ClusterParams {
+    fn default() -> Self {
+        Self {
+            link_tolerance_m: 0.5,
+            link_tolerance_rel: 0.05,
+            min_cluster_points: 5,
+            min_large_points: 100,
+            min_large_fraction: 0.005,
+            area_cell_m: 2.0,
+            max_step_m: 0.5,
+        }
+    }
+}
+
+impl ClusterParams {
+    /// Refuses values outside their ranges.
+    pub fn validate(&self) -> Result<()> {
+        let pos = |v: f32| v.is_finite() && v > 0.0;
+        if !pos(self.link_tolerance_m) {
+            return Err(ClassifyError::invalid("link_tolerance_m", self.link_tolerance_m, "finite, > 0"));
+        }
+        if !(self.link_tolerance_rel.is_finite() && self.link_tolerance_rel >= 0.0) {
+            return Err(ClassifyError::invalid("link_tolerance_rel", self.link_tolerance_rel, "finite, >= 0"));
+        }
+        if !(self.min_large_fraction.is_finite() && (0.0..=1.0).contains(&self.min_large_fraction)) {
+            return Err(ClassifyError::invalid("min_large_fraction", self.min_large_fraction, "0 ..= 1"));
+        }
+        if !pos(self.area_cell_m) {
+            return Err(ClassifyError::invalid("area_cell_m", self.area_cell_m, "finite, > 0"));
+        }
+        if !(self.max_step_m.is_finite() && self.max_step_m >= 0.0) {
+            return Err(ClassifyError::invalid("max_step_m", self.max_step_m, "finite, >= 0"));
+        }
+        Ok(())
+    }
+}
+
+/// Reusable buffers of the clustering (no allocation per frame once warm).
+#[derive(Clone, Debug, Default)]
+pub struct ClusterWorkspace {
+    /// Union-find parent per cell (`u32::MAX` for non-candidates).
+    parent: Vec<u32>,
+    /// Cluster size per root.
+    size: Vec<u32>,
+    /// Per-cluster accumulators of the area test, indexed by root.
+    inside: Vec<u32>,
+    height_sum: Vec<f32>,
+    /// Ground-area squares: (sum z, count) per square in a bounding box.
+    area: Vec<(f32, u32)>,
+    /// Decision per root.
+    root_ground: Vec<bool>,
+}
+
+const NONE: u32 = u32::MAX;
+
+#[inline]
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let g = parent[parent[i as usize] as usize];
+        parent[i as usize] = g;
+        i = g;
+    }
+    i
+}
+
+/// Clusters the candidate cells (`candidate[i]`) of `view` by conditional Euclidean clustering on
+/// the grid. Afterwards [`ClusterWorkspace::cluster_of`] gives each candidate's cluster root and
+/// [`ClusterWorkspace::cluster_size`] its size.
+pub fn cluster_candidates(view: &GridView<'_>, candidate: &[bool], params: &ClusterParams, ws: &mut ClusterWorkspace) {
+    let n = view.rows * view.cols;
+    ws.parent.clear();
+    ws.parent.extend((0..n as u32).map(|i| if candidate[i as usize] { i } else { NONE }));
+    ws.size.clear();
+    ws.size.resize(n, 0);
+    let (a, b) = (params.link_tolerance_m, params.link_tolerance_rel);
+    for r in 0..view.rows {
+        for c in 0..view.cols {
+            let i = r * view.cols + c;
+            if ws.parent[i] == NONE {
+                continue;
+            }
+            let p = view.points[i];
+            let pl = p.length();
+            for j in view.neighbours(r, c).into_iter().flatten() {
+                // Links are unions, so visiting a pair from both ends is harmless.
+                if ws.parent[j] == NONE || j == i {
+                    continue;
+                }
+                let q = view.points[j];
+                let tol = a + b * pl.max(q.length());
+                if p.distance_squared(q) <= tol * tol {
+                    let (ri, rj) = (find(&mut ws.parent, i as u32), find(&mut ws.parent, j as u32));
+                    if ri != rj {
+                        // Union by index keeps the result independent of visiting order details.
+                        let (lo, hi) = if ri < rj { (ri, rj) } else { (rj, ri) };
+                        ws.parent[hi as usize] = lo;
+                    }
+                }
+            }
+        }
+    }
+    for i in 0..n {
+        if ws.parent[i] != NONE {
+            let root = find(&mut ws.parent, i as u32);
+            ws.size[root as usize] += 1;
+        }
+    }
+}
+
+impl ClusterWorkspace {
+    /// Cluster root of cell `i` after [`cluster_candidates`], `None` for non-candidates.
+    pub fn cluster_of(&self, i: usize) -> Option<usize> {
+        let mut r = self.parent[i];
+        if r == NONE {
+            return None;
+        }
+        while self.parent[r as usize] != r {
+            r = self.parent[r as usize];
+        }
+        Some(r as usize)
+    }
+
+    /// Number of points in the cluster with root `root`.
+    pub fn cluster_size(&self, root: usize) -> usize {
+        self.size[root] as usize
+    }
+
+    /// Number of clusters.
+    pub fn cluster_count(&self) -> usize {
+        self.size.iter().filter(|&&s| s > 0).count()
+    }
+
+    /// Applies the cluster rules (module docs) and writes the ground decision of every cell of the
+    /// plane into `ground` (non-candidates false). `returns` is the number of returns of the plane.
+    pub fn decide(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
+        let n = self.parent.len();
+        // Path-compress every candidate so parent[i] is its root.
+        for i in 0..n {
+            if self.parent[i] != NONE {
+                let r = find(&mut self.parent, i as u32);
+                self.parent[i] = r;
+            }
+        }
+        ground[..n].fill(false);
+        let Some((largest, _)) =
+            self.size.iter().enumerate().filter(|&(_, &s)| s > 0).max_by_key(|&(i, &s)| (s, std::cmp::Reverse(i)))
+        else {
+            return;
+        };
+        // Ground area: squares holding points of the largest cluster, over its bounding box.
+        let cell = params.area_cell_m;
+        let (mut lo, mut hi) = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
+        for i in 0..n {
+            if self.parent[i] == largest as u32 {
+                lo = lo.min(points[i].truncate());
+                hi = hi.max(points[i].truncate());
+            }
+        }
+        let nx = (((hi.x - lo.x) / cell).floor() as usize).saturating_add(1).min(4096);
+        let ny = (((hi.y - lo.y) / cell).floor() as usize).saturating_add(1).min(4096);
+        self.area.clear();
+        self.area.resize(nx * ny, (0.0, 0));
+        let square = |p: Vec3| -> (isize, isize) {
+            (((p.x - lo.x) / cell).floor() as isize, ((p.y - lo.y) / cell).floor() as isize)
+        };
+        for i in 0..n {
+            if self.parent[i] == largest as u32 {
+                let (x, y) = square(points[i]);
+                let (x, y) = (x.clamp(0, nx as isize - 1) as usize, y.clamp(0, ny as isize - 1) as usize);
+                let e = &mut self.area[y * nx + x];
+                e.0 += points[i].z;
+                e.1 += 1;
+            }
+        }
+        // Area test per cluster: count inside points and their height above the local ground.
+        self.inside.clear();
+        self.inside.resize(n, 0);
+        self.height_sum.clear();
+        self.height_sum.resize(n, 0.0);
+        for i in 0..n {
+            let root = self.parent[i];
+            if root == NONE || root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points {
+                continue;
+            }
+            let (x, y) = square(points[i]);
+            let (mut zs, mut cnt) = (0.0f32, 0u32);
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let (xx, yy) = (x + dx, y + dy);
+                    if xx >= 0 && yy >= 0 && (xx as usize) < nx && (yy as usize) < ny {
+                        let e = self.area[yy as usize * nx + xx as usize];
+                        zs += e.0;
+                        cnt += e.1;
+                    }
+                }
+            }
+            if cnt > 0 {
+                self.inside[root as usize] += 1;
+                self.height_sum[root as usize] += points[i].z - zs / cnt as f32;
+            }
+        }
+        let min_large = params.min_large_points.max((params.min_large_fraction * returns as f32).ceil() as usize);
+        self.root_ground.clear();
+        self.root_ground.resize(n, false);
+        for root in 0..n {
+            let size = self.size[root] as usize;
+            if size == 0 {
+                continue;
+            }
+            self.root_ground[root] = if root == largest {
+                true
+            } else if size < params.min_cluster_points {
+                false
+            } else if 2 * self.inside[root] as usize >= size {
+                self.height_sum[root] / (self.inside[root] as f32) <= params.max_step_m
+            } else {
+                size >= min_large
+            };
+        }
+        for i in 0..n {
+            let root = self.parent[i];
+            ground[i] = root != NONE && self.root_ground[root as usize] && is_valid(points[i]);
+        }
+    }
+}

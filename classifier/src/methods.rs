@@ -1,0 +1,91 @@
+//! The registry of classification methods by name, behind one trait.
+
+use glam::Affine3A;
+
+use crate::baselines::grid::{GridAccumulation, GridParams};
+use crate::baselines::ransac::{self, RansacParams};
+use crate::error::{ClassifyError, Result};
+use crate::nitsch::{Nitsch, NitschParams, StageTimes};
+
+/// Every method name, as the command line takes them.
+pub const METHODS: &[&str] =
+    &["nitsch", "nitsch-0.7", "nitsch-no-cluster", "nitsch-no-cluster-0.7", "ransac", "grid", "grid-no-cluster"];
+
+/// One frame to classify.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameInput<'a> {
+    /// Frame index (seeds RANSAC).
+    pub index: usize,
+    /// The cloud.
+    pub cloud: &'a sim::OrderedCloud,
+    /// Vehicle pose in the world (grid accumulation); `None` when unknown.
+    pub world_from_vehicle: Option<Affine3A>,
+}
+
+/// A ground classifier: one decision per cell of the cloud (all planes, grid order), true = ground,
+/// false for cells without a return. Methods may keep state between frames (grid accumulation), so
+/// frames are given in order.
+pub trait GroundClassifier {
+    /// The method's registry name.
+    fn name(&self) -> &'static str;
+    /// Classifies one frame.
+    fn classify(&mut self, frame: &FrameInput<'_>) -> Result<Vec<bool>>;
+    /// Stage times of the last frame, where the method measures them.
+    fn stage_times(&self) -> Option<StageTimes> {
+        None
+    }
+}
+
+struct NitschMethod(&'static str, Nitsch);
+
+impl GroundClassifier for NitschMethod {
+    fn name(&self) -> &'static str {
+        self.0
+    }
+    fn classify(&mut self, frame: &FrameInput<'_>) -> Result<Vec<bool>> {
+        self.1.classify(frame.cloud)
+    }
+    fn stage_times(&self) -> Option<StageTimes> {
+        Some(self.1.times)
+    }
+}
+
+struct RansacMethod(RansacParams);
+
+impl GroundClassifier for RansacMethod {
+    fn name(&self) -> &'static str {
+        "ransac"
+    }
+    fn classify(&mut self, frame: &FrameInput<'_>) -> Result<Vec<bool>> {
+        ransac::classify(frame.cloud, &self.0, frame.index as u64)
+    }
+}
+
+struct GridMethod(&'static str, GridAccumulation);
+
+impl GroundClassifier for GridMethod {
+    fn name(&self) -> &'static str {
+        self.0
+    }
+    fn classify(&mut self, frame: &FrameInput<'_>) -> Result<Vec<bool>> {
+        self.1.classify(frame.cloud, frame.world_from_vehicle)
+    }
+}
+
+/// Builds the method called `name` with its default parameters; `seed` seeds RANSAC.
+pub fn method_by_name(name: &str, seed: u64) -> Result<Box<dyn GroundClassifier + Send>> {
+    let nitsch = |threshold: f32, cluster: bool| NitschParams { threshold, cluster, ..Default::default() };
+    Ok(match name {
+        "nitsch" => Box::new(NitschMethod("nitsch", Nitsch::new(nitsch(0.6, true))?)),
+        "nitsch-0.7" => Box::new(NitschMethod("nitsch-0.7", Nitsch::new(nitsch(0.7, true))?)),
+        "nitsch-no-cluster" => Box::new(NitschMethod("nitsch-no-cluster", Nitsch::new(nitsch(0.6, false))?)),
+        "nitsch-no-cluster-0.7" => Box::new(NitschMethod("nitsch-no-cluster-0.7", Nitsch::new(nitsch(0.7, false))?)),
+        "ransac" => Box::new(RansacMethod(RansacParams { seed, ..Default::default() })),
+        "grid" => Box::new(GridMethod("grid", GridAccumulation::new(GridParams::default())?)),
+        "grid-no-cluster" => Box::new(GridMethod(
+            "grid-no-cluster",
+            GridAccumulation::new(GridParams { cluster: false, ..Default::default() })?,
+        )),
+        _ => return Err(ClassifyError::UnknownMethod { name: name.to_string(), known: METHODS.join(", ") }),
+    })
+}

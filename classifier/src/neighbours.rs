@@ -1,0 +1,197 @@
+//! The 8-neighbourhood of a cell on the ordered grid, enumerated as in Fig. 3 of Nitsch et al. so
+//! that flat horizontal ground below the sensor gives normals pointing to `+z`.
+//!
+//! Grid convention (see `sim::OrderedCloud`): row 0 is the lowest beam and rows go up in elevation
+//! (on ground: farther away); column 0 is left-most and azimuth decreases with the column index
+//! (clockwise seen from above). With `d_i = P_i - P` and `n_i = d_i x d_(i-1)` the neighbours must
+//! be visited clockwise seen from above, which in grid offsets `(row, col)` is
+//!
+//! ```text
+//!   d8 (+1,-1)   d1 (+1, 0)   d2 (+1,+1)
+//!   d7 ( 0,-1)       P        d3 ( 0,+1)
+//!   d6 (-1,-1)   d5 (-1, 0)   d4 (-1,+1)
+//! ```
+//!
+//! (for ground ahead, `d1` points forward, `d3` to the right; `d3 x d2`, `d2 x d1`, ... are `+z`).
+//!
+//! Missing neighbours (decision, tested): a neighbour is the nearest *return* in its direction,
+//! searched up to `max_col_gap` columns away along the row, because merged multi-sensor grids and
+//! dropouts leave empty cells between physical neighbours. In the rows above and below, the centre
+//! neighbour (`d1`, `d5`) is the return nearest to the cell's column (within `max_col_gap`, `+` side
+//! first on ties), and the diagonal neighbours are the next returns beyond it on either side. With a
+//! dense grid this is exactly the plain 8-neighbourhood. Beyond the grid's top and bottom rows there
+//! is nothing; beyond its left and right columns the search wraps only for 360-degree sensors
+//! ([`Wrap`]). A neighbour farther than `max_distance_m` from the cell is dropped (the paper uses no
+//! such threshold, so the default is infinity).
+
+use glam::Vec3;
+
+use crate::error::is_valid;
+
+/// Whether column 0 and column `cols - 1` are neighbours (a sensor that spins all the way round).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// Decide from the data with [`detect_wrap`].
+    #[default]
+    Auto,
+    /// Always wrap (360-degree sensor).
+    Always,
+    /// Never wrap (sensor with a limited field of view).
+    Never,
+}
+
+/// How neighbours are looked up on the grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeighbourParams {
+    /// How far along a row to look for the nearest return, columns (>= 1; 1 = direct neighbours only).
+    pub max_col_gap: usize,
+    /// Neighbours farther than this from the cell are missing, metres (infinity = no threshold, as in the paper).
+    pub max_distance_m: f32,
+    /// Column wrap-around.
+    pub wrap: Wrap,
+}
+
+impl Default for NeighbourParams {
+    fn default() -> Self {
+        Self { max_col_gap: 2, max_distance_m: f32::INFINITY, wrap: Wrap::Auto }
+    }
+}
+
+/// A view of one echo plane of a cloud as a rows x cols grid of points.
+#[derive(Clone, Copy, Debug)]
+pub struct GridView<'a> {
+    /// Points of the plane, row-major, NaN where no return.
+    pub points: &'a [Vec3],
+    /// Rows.
+    pub rows: usize,
+    /// Columns.
+    pub cols: usize,
+    /// Whether columns wrap around (resolved, not `Auto`).
+    pub wrap: bool,
+    /// Column search distance, >= 1.
+    pub max_col_gap: usize,
+}
+
+impl<'a> GridView<'a> {
+    /// Column `c + k` (k may be negative) in range, wrapping if the grid wraps.
+    #[inline]
+    fn col(&self, c: usize, k: isize) -> Option<usize> {
+        let cc = c as isize + k;
+        if cc >= 0 && (cc as usize) < self.cols {
+            Some(cc as usize)
+        } else if self.wrap {
+            Some(cc.rem_euclid(self.cols as isize) as usize)
+        } else {
+            None
+        }
+    }
+
+    /// The first return in row `r` starting one step from `c` in direction `step` (+1 / -1).
+    #[inline]
+    fn first_along(&self, r: usize, c: usize, step: isize) -> Option<usize> {
+        let base = r * self.cols;
+        for k in 1..=self.max_col_gap as isize {
+            let cc = self.col(c, k * step)?;
+            if is_valid(self.points[base + cc]) {
+                return Some(cc);
+            }
+        }
+        None
+    }
+
+    /// The return in row `r` nearest to column `c` (`c` itself, then `c+1`, `c-1`, `c+2`, ...).
+    #[inline]
+    fn nearest_in_row(&self, r: usize, c: usize) -> Option<usize> {
+        let base = r * self.cols;
+        if is_valid(self.points[base + c]) {
+            return Some(c);
+        }
+        for k in 1..=self.max_col_gap as isize {
+            for kk in [k, -k] {
+                if let Some(cc) = self.col(c, kk)
+                    && is_valid(self.points[base + cc])
+                {
+                    return Some(cc);
+                }
+            }
+        }
+        None
+    }
+
+    /// Cell indices (within the plane) of the 8 neighbours of `(r, c)` in the order `d1..d8` of the
+    /// module docs; `None` where missing (distance threshold not applied here).
+    #[inline]
+    pub fn neighbours(&self, r: usize, c: usize) -> [Option<usize>; 8] {
+        let mut out = [None; 8];
+        let cols = self.cols;
+        if r + 1 < self.rows {
+            let up = r + 1;
+            if let Some(cc) = self.nearest_in_row(up, c) {
+                out[0] = Some(up * cols + cc);
+                out[1] = self.first_along(up, cc, 1).map(|x| up * cols + x);
+                out[7] = self.first_along(up, cc, -1).map(|x| up * cols + x);
+            }
+        }
+        out[2] = self.first_along(r, c, 1).map(|x| r * cols + x);
+        out[6] = self.first_along(r, c, -1).map(|x| r * cols + x);
+        if r > 0 {
+            let dn = r - 1;
+            if let Some(cc) = self.nearest_in_row(dn, c) {
+                out[4] = Some(dn * cols + cc);
+                out[3] = self.first_along(dn, cc, 1).map(|x| dn * cols + x);
+                out[5] = self.first_along(dn, cc, -1).map(|x| dn * cols + x);
+            }
+        }
+        out
+    }
+}
+
+/// Decides whether a plane's columns span a full turn, from the data: the azimuths (about the
+/// vehicle's z axis) of the returns in the first and last columns must be about one column step
+/// apart across the +-pi cut, and the columns together must cover more than 350 degrees.
+/// A sensor mounted off the vehicle origin shifts near azimuths, so each column's azimuth is taken
+/// from its farthest return. Returns false when a column has no return to judge from.
+pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
+    if cols < 3 || rows == 0 || points.len() < rows * cols {
+        return false;
+    }
+    let col_azimuth = |c: usize| -> Option<f32> {
+        let mut best: Option<(f32, f32)> = None;
+        for r in 0..rows {
+            let p = points[r * cols + c];
+            if is_valid(p) {
+                let d2 = p.x * p.x + p.y * p.y;
+                if best.is_none_or(|(bd, _)| d2 > bd) {
+                    best = Some((d2, p.y.atan2(p.x)));
+                }
+            }
+        }
+        best.map(|(_, a)| a)
+    };
+    let wrap_diff = |a: f32, b: f32| {
+        let mut d = a - b;
+        while d > std::f32::consts::PI {
+            d -= std::f32::consts::TAU;
+        }
+        while d < -std::f32::consts::PI {
+            d += std::f32::consts::TAU;
+        }
+        d
+    };
+    let (Some(first), Some(last)) = (col_azimuth(0), col_azimuth(cols - 1)) else {
+        return false;
+    };
+    let step = std::f32::consts::TAU / cols as f32;
+    // Azimuth decreases with the column index, so the last column sits one step "before" column 0.
+    let gap = wrap_diff(last, first).abs();
+    // Total sweep: walk columns with returns and add up the (decreasing) azimuth differences.
+    let mut swept = 0.0f32;
+    let mut prev = first;
+    for c in 1..cols {
+        if let Some(a) = col_azimuth(c) {
+            swept += wrap_diff(prev, a).abs();
+            prev = a;
+        }
+    }
+    gap < 4.0 * step && swept > 350f32.to_radians()
+}

@@ -1,0 +1,130 @@
+//! Feature tests on analytic synthetic clouds: flat ground, walls, missing neighbours, wrap-around.
+
+use classifier::features::{FeatureParams, Features, compute_features};
+use classifier::neighbours::{GridView, detect_wrap};
+use classifier::synthetic::{Shape, SyntheticSensor, flat_ground};
+use glam::Vec3;
+use sim::{OrderedCloud, SemanticClass};
+
+fn features(cloud: &OrderedCloud, wrap: bool, params: FeatureParams) -> Features {
+    let view = GridView { points: &cloud.point_in_vehicle, rows: cloud.rows, cols: cloud.cols, wrap, max_col_gap: 2 };
+    let mut f = Features::default();
+    compute_features(&view, &params, &mut f);
+    f
+}
+
+#[test]
+fn flat_ground_gives_up_normals_and_g_rho_one_all_around() {
+    let sensor = SyntheticSensor::spinning(16, 360, -25.0, -5.0, 1.8);
+    let cloud = sensor.scan(&[flat_ground()]);
+    assert_eq!(cloud.returns(), 16 * 360);
+    let f = features(&cloud, true, FeatureParams::default());
+    let mut worst_deg = 0f32;
+    for i in 0..cloud.len() {
+        let angle = f.normal[i].angle_between(Vec3::Z).to_degrees();
+        worst_deg = worst_deg.max(angle);
+        assert!(f.g_rho[i] > 0.999, "cell {i}: g_rho {}", f.g_rho[i]);
+    }
+    assert!(worst_deg < 0.5, "worst normal off +z by {worst_deg} deg");
+}
+
+#[test]
+fn wall_gives_g_rho_near_zero() {
+    // A forward sensor in front of a vertical wall 8 m ahead (no ground in the way: rings look up).
+    let sensor = SyntheticSensor::forward(8, 60, 2.0, 20.0, 60.0, 1.8);
+    let wall = Shape::Patch {
+        point: Vec3::new(8.0, 0.0, 0.0),
+        normal: Vec3::NEG_X,
+        min_xy: glam::Vec2::new(7.0, -50.0),
+        max_xy: glam::Vec2::new(9.0, 50.0),
+        class: SemanticClass::BUILDING,
+    };
+    let cloud = sensor.scan(&[wall]);
+    assert_eq!(cloud.returns(), 8 * 60);
+    let f = features(&cloud, false, FeatureParams::default());
+    for i in 0..cloud.len() {
+        assert!(f.g_rho[i].abs() < 0.02, "cell {i}: g_rho {}", f.g_rho[i]);
+        // The normal points back at the sensor (-x), and the quality of a plane is still 1.
+        assert!(f.normal[i].dot(Vec3::NEG_X) > 0.999, "normal {:?}", f.normal[i]);
+        assert!(f.n_rho[i] > 0.999);
+    }
+}
+
+#[test]
+fn lowest_ring_and_grid_edges_keep_features() {
+    // Forward sensor: no wrap; row 0 lacks the neighbours below, columns 0 / last lack one side.
+    let sensor = SyntheticSensor::forward(6, 40, -20.0, -10.0, 40.0, 1.8);
+    let cloud = sensor.scan(&[flat_ground()]);
+    let f = features(&cloud, false, FeatureParams::default());
+    // Row 0, middle column: 4 of 8 pairs exist; n_rho averages over those, so g_rho ~ 1.
+    assert!(f.g_rho[20] > 0.999);
+    // Corner (row 0, col 0): only d1, d2, d3 exist -> 2 pairs -> still features (min 2).
+    assert!(f.g_rho[0] > 0.999);
+    // With min_valid_pairs = 3 the corner gets none, the edge still does.
+    let f3 = features(&cloud, false, FeatureParams { min_valid_pairs: 3, ..Default::default() });
+    assert_eq!(f3.g_rho[0], 0.0);
+    assert_eq!(f3.normal[0], Vec3::ZERO);
+    assert!(f3.g_rho[20] > 0.999);
+}
+
+#[test]
+fn missing_neighbours_are_skipped_or_bridged() {
+    let sensor = SyntheticSensor::forward(6, 40, -20.0, -10.0, 40.0, 1.8);
+    let mut cloud = sensor.scan(&[flat_ground()]);
+    let at = |r: usize, c: usize| r * 40 + c;
+    // Knock out the right neighbour of (3, 20): the gap search takes (3, 22) instead.
+    cloud.point_in_vehicle[at(3, 21)] = Vec3::NAN;
+    cloud.range_m[at(3, 21)] = f32::NAN;
+    // An isolated return: everything around (1, 5) empty, up to 2 columns away.
+    for r in 0..3 {
+        for c in 3..=7 {
+            if (r, c) != (1, 5) {
+                cloud.point_in_vehicle[at(r, c)] = Vec3::NAN;
+            }
+        }
+    }
+    // Corrupt input: finite range but NaN coordinates counts as no return.
+    cloud.point_in_vehicle[at(4, 30)] = Vec3::new(f32::NAN, 1.0, 0.0);
+    let f = features(&cloud, false, FeatureParams::default());
+    assert!(f.g_rho[at(3, 20)] > 0.999);
+    assert!(f.g_rho[at(3, 22)] > 0.999);
+    assert_eq!(f.g_rho[at(3, 21)], 0.0, "no return, no features");
+    assert_eq!(f.g_rho[at(1, 5)], 0.0, "isolated return: no pair normals");
+    assert_eq!(f.g_rho[at(4, 30)], 0.0);
+    assert!(f.g_rho[at(4, 29)] > 0.999, "the NaN neighbour is bridged");
+    // With direct neighbours only, an isolated column gap still leaves the up/down pairs.
+    let view = GridView { points: &cloud.point_in_vehicle, rows: 6, cols: 40, wrap: false, max_col_gap: 1 };
+    let nb = view.neighbours(3, 20);
+    assert_eq!(nb[2], None, "right neighbour missing without gap search");
+    assert_eq!(nb[0], Some(at(4, 20)));
+    assert_eq!(nb[1], Some(at(4, 21)));
+}
+
+#[test]
+fn far_neighbours_are_dropped_by_the_distance_threshold() {
+    let sensor = SyntheticSensor::forward(6, 40, -20.0, -10.0, 40.0, 1.8);
+    let cloud = sensor.scan(&[flat_ground()]);
+    // Row spacing on the ground at these elevations is > 1 m, column spacing < 0.6 m.
+    let f = features(&cloud, false, FeatureParams { max_neighbour_distance_m: 0.6, ..Default::default() });
+    // Only the left and right neighbours remain: they are not adjacent in the enumeration -> no pairs.
+    assert_eq!(f.g_rho[3 * 40 + 20], 0.0);
+    let f = features(&cloud, false, FeatureParams { max_neighbour_distance_m: 50.0, ..Default::default() });
+    assert!(f.g_rho[3 * 40 + 20] > 0.999);
+}
+
+#[test]
+fn wrap_is_detected_for_full_turns_only_and_joins_the_seam() {
+    let spin = SyntheticSensor::spinning(8, 180, -25.0, -5.0, 1.8).scan(&[flat_ground()]);
+    assert!(detect_wrap(&spin.point_in_vehicle, 8, 180));
+    let fwd = SyntheticSensor::forward(8, 180, -25.0, -5.0, 120.0, 1.8).scan(&[flat_ground()]);
+    assert!(!detect_wrap(&fwd.point_in_vehicle, 8, 180));
+    // At the seam, with wrap, column 0 sees column 179 as its left neighbour.
+    let view = GridView { points: &spin.point_in_vehicle, rows: 8, cols: 180, wrap: true, max_col_gap: 2 };
+    assert_eq!(view.neighbours(3, 0)[6], Some(3 * 180 + 179));
+    let fw = features(&spin, true, FeatureParams::default());
+    let fnw = features(&spin, false, FeatureParams::default());
+    // Both give upward normals on flat ground; with wrap the seam cells have all 8 pairs.
+    assert!(fw.g_rho[3 * 180] > 0.999 && fnw.g_rho[3 * 180] > 0.999);
+    let (d1, d2) = (spin.point_in_vehicle[3 * 180 + 179], spin.point_in_vehicle[3 * 180]);
+    assert!(d1.distance(d2) < 0.3, "seam columns are physical neighbours");
+}
