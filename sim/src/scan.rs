@@ -1,1 +1,434 @@
-//! TODO
+//! The scan pipeline: for each frame and each sensor row, build the world rays of the row's beams
+//! at each shot's own vehicle pose, cast them, apply the measurement effects and write the cells of
+//! the rig's merged ordered grid ([`crate::layout`]).
+//!
+//! Points are reported in the vehicle frame **at each shot's own time** (like a real sensor whose
+//! driver does not compensate ego motion), so a moving vehicle's clouds show motion distortion; the
+//! per-frame poses are returned with each frame so users can compensate.
+//!
+//! Work is split by rows of the merged grid (one rayon task per row); every random draw is keyed by
+//! (seed, frame, sensor, ring, column), so output is identical at any thread count.
+
+use glam::{Affine3A, Vec3};
+
+use crate::cast::{Backend, Caster, Hit, Ray};
+use crate::cloud::OrderedCloud;
+use crate::effects::{cast_limit_m, measure};
+use crate::error::{Result, SimError, check_range};
+use crate::layout::RigLayout;
+use crate::motion::{PoseTrack, Trajectory, VehiclePose};
+use crate::noise::BeamKey;
+use crate::rig::Rig;
+use crate::scene::{SceneMesh, SemanticClass};
+use crate::sensor::{Firing, Measurement, ScanPattern};
+
+/// Largest number of frames one scan may produce.
+pub const MAX_FRAMES: usize = 100_000;
+
+/// How to scan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScanConfig {
+    /// Seed of every random draw (range noise).
+    pub seed: u64,
+    /// Number of frames (1 ..= [`MAX_FRAMES`]).
+    pub frames: usize,
+    /// Ego speed, metres per second (|v| <= 100).
+    pub speed_m_per_s: f32,
+    /// Ego yaw rate, radians per second (|w| <= 2).
+    pub yaw_rate_rad_per_s: f32,
+    /// Turn every measurement effect off (exact distances).
+    pub ideal: bool,
+    /// Ray casting backend.
+    pub backend: Backend,
+    /// Height of the ground under the ego vehicle at the start, metres (a hint for terrain following).
+    pub ego_z_m: f32,
+}
+
+impl Default for ScanConfig {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            frames: 1,
+            speed_m_per_s: 0.0,
+            yaw_rate_rad_per_s: 0.0,
+            ideal: false,
+            backend: Backend::Bvh,
+            ego_z_m: 0.0,
+        }
+    }
+}
+
+impl ScanConfig {
+    /// Checks every field, naming the field and its allowed range.
+    pub fn validate(&self) -> Result<()> {
+        if self.frames == 0 || self.frames > MAX_FRAMES {
+            return Err(SimError::invalid("frames", self.frames, format!("1 ..= {MAX_FRAMES}")));
+        }
+        check_range("speed_m_per_s", f64::from(self.speed_m_per_s), -100.0, 100.0)?;
+        check_range("yaw_rate_rad_per_s", f64::from(self.yaw_rate_rad_per_s), -2.0, 2.0)?;
+        check_range("ego_z_m", f64::from(self.ego_z_m), -10_000.0, 10_000.0)
+    }
+}
+
+/// One scanned frame.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Frame index.
+    pub index: usize,
+    /// Start of the frame, seconds since the start of the scan.
+    pub start_time_s: f64,
+    /// Vehicle pose at the start of the frame.
+    pub vehicle_pose: VehiclePose,
+    /// `vehicle_pose` as a transform.
+    pub world_from_vehicle: Affine3A,
+    /// The ordered labelled cloud.
+    pub cloud: OrderedCloud,
+}
+
+/// A rig placed in a scene, ready to scan frames.
+pub struct Scanner<'a> {
+    mesh: &'a SceneMesh,
+    caster: Box<dyn Caster>,
+    normals: Vec<Vec3>,
+    patterns: Vec<ScanPattern>,
+    measurements: Vec<Measurement>,
+    vehicle_from_sensor: Vec<Affine3A>,
+    layout: RigLayout,
+    /// `row_source[merged_row] = (sensor, ring)`.
+    row_source: Vec<(usize, usize)>,
+    planes: usize,
+    track: PoseTrack,
+    frame_period_s: f64,
+    config: ScanConfig,
+}
+
+/// Casts all frames of a scan and returns them (for small scans; large ones use [`Scanner`] frame by frame).
+pub fn scan(mesh: &SceneMesh, rig: &Rig, config: &ScanConfig) -> Result<Vec<Frame>> {
+    let scanner = Scanner::new(mesh, rig, config.clone())?;
+    Ok((0..config.frames).map(|k| scanner.frame(k)).collect())
+}
+
+impl<'a> Scanner<'a> {
+    /// Validates the inputs, builds the caster and the rig layout, and settles the ego trajectory.
+    pub fn new(mesh: &'a SceneMesh, rig: &'a Rig, config: ScanConfig) -> Result<Self> {
+        config.validate()?;
+        rig.validate()?;
+        mesh.validate().map_err(|m| SimError::invalid("scene mesh", m, "finite vertices, valid indices"))?;
+        let caster = config.backend.build(mesh);
+        let normals = (0..mesh.len()).map(|i| mesh.triangle_normal(i)).collect();
+        let patterns: Vec<ScanPattern> = rig.sensors.iter().map(|s| s.spec.pattern()).collect();
+        let measurements: Vec<Measurement> = rig
+            .sensors
+            .iter()
+            .map(|s| if config.ideal { s.spec.measurement().ideal() } else { s.spec.measurement() })
+            .collect();
+        let vehicle_from_sensor = rig.sensors.iter().map(|s| s.mount.vehicle_from_sensor()).collect();
+        let layout = RigLayout::new(rig, &patterns);
+        let mut row_source = vec![(0, 0); layout.rows];
+        for (s, rows) in layout.row_of.iter().enumerate() {
+            for (r, &m) in rows.iter().enumerate() {
+                row_source[m] = (s, r);
+            }
+        }
+        let planes = measurements.iter().map(|m| usize::from(m.max_echoes.max(1))).max().unwrap_or(1);
+        let frame_period_s = patterns.iter().map(|p| p.frame_period_s).fold(0.0, f64::max);
+        let trajectory = Trajectory {
+            speed_m_per_s: f64::from(config.speed_m_per_s),
+            yaw_rate_rad_per_s: f64::from(config.yaw_rate_rad_per_s),
+        };
+        let track =
+            PoseTrack::new(caster.as_ref(), trajectory, frame_period_s, config.frames, f64::from(config.ego_z_m));
+        Ok(Self {
+            mesh,
+            caster,
+            normals,
+            patterns,
+            measurements,
+            vehicle_from_sensor,
+            layout,
+            row_source,
+            planes,
+            track,
+            frame_period_s,
+            config,
+        })
+    }
+
+    /// The rig's merged grid layout.
+    pub fn layout(&self) -> &RigLayout {
+        &self.layout
+    }
+
+    /// The firing pattern of each sensor.
+    pub fn patterns(&self) -> &[ScanPattern] {
+        &self.patterns
+    }
+
+    /// The measurement model in force for each sensor (ideal if the scan is ideal).
+    pub fn measurements(&self) -> &[Measurement] {
+        &self.measurements
+    }
+
+    /// Frame period of the rig (the longest sensor period), seconds.
+    pub fn frame_period_s(&self) -> f64 {
+        self.frame_period_s
+    }
+
+    /// Echo planes of every frame's cloud.
+    pub fn planes(&self) -> usize {
+        self.planes
+    }
+
+    /// The caster in use.
+    pub fn caster(&self) -> &dyn Caster {
+        self.caster.as_ref()
+    }
+
+    /// Scans frame `index`.
+    pub fn frame(&self, index: usize) -> Frame {
+        use rayon::prelude::*;
+        let (rows, cols) = (self.layout.rows, self.layout.cols);
+        let mut cloud = OrderedCloud::empty(rows, cols, self.planes);
+        let start_time_s = index as f64 * self.frame_period_s;
+        let extra: Vec<Vec<ExtraEcho>> = if cols == 0 {
+            Vec::new()
+        } else {
+            row_views(&mut cloud)
+                .into_par_iter()
+                .enumerate()
+                .map(|(row, mut view)| self.scan_row(index, start_time_s, row, &mut view))
+                .collect()
+        };
+        for e in extra.into_iter().flatten() {
+            let i = cloud.index(usize::from(e.echo), e.row, e.col);
+            e.cell.write(&mut cloud, i, e.echo);
+        }
+        let vehicle_pose = self.track.frame_start(index);
+        Frame { index, start_time_s, vehicle_pose, world_from_vehicle: vehicle_pose.world_from_vehicle(), cloud }
+    }
+
+    /// Scans one merged row into its plane-0 cells; returns second and later echoes.
+    fn scan_row(&self, frame: usize, start_time_s: f64, row: usize, view: &mut RowView<'_>) -> Vec<ExtraEcho> {
+        let (s, ring) = self.row_source[row];
+        let pattern = &self.patterns[s];
+        let m = &self.measurements[s];
+        let vehicle_from_sensor = self.vehicle_from_sensor[s];
+        let static_world_from_sensor = self.track.frame_start(frame).world_from_vehicle() * vehicle_from_sensor;
+        let t_max = cast_limit_m(m);
+        let sub_rays = if m.max_echoes > 1 && m.beam_divergence_rad > 0.0 { 3 } else { 1 };
+
+        for v in view.ring.iter_mut() {
+            *v = ring as u16;
+        }
+        // Gather the row's beams and their world rays, in column order (coherent for the caster).
+        let mut beams: Vec<(usize, Firing, Affine3A)> = Vec::with_capacity(pattern.cols);
+        let mut rays: Vec<Ray> = Vec::with_capacity(pattern.cols * sub_rays);
+        for c in 0..pattern.cols {
+            let mc = self.layout.col_of[s][c];
+            view.sensor[mc] = s as u8;
+            view.column[mc] = c as u32;
+            view.time[mc] = start_time_s;
+            let Some(f) = pattern.at(ring, c) else { continue };
+            let time_s = start_time_s + f.time_s;
+            view.time[mc] = time_s;
+            let world_from_sensor = if self.track.is_static() {
+                static_world_from_sensor
+            } else {
+                self.track.at(time_s).world_from_vehicle() * vehicle_from_sensor
+            };
+            let origin = world_from_sensor.transform_point3(f.origin_in_sensor);
+            let dir = world_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
+            rays.push(Ray { origin, dir, t_max });
+            if sub_rays > 1 {
+                // Sub-beams at the horizontal edges of the divergence cone (edge straddling -> echoes).
+                let side = world_from_sensor.transform_vector3(f.dir_in_sensor.cross(Vec3::Z)).normalize_or_zero();
+                let off = (0.5 * m.beam_divergence_rad).tan();
+                for sign in [-1.0f32, 1.0] {
+                    rays.push(Ray { origin, dir: (dir + side * (sign * off)).normalize(), t_max });
+                }
+            }
+            beams.push((c, *f, world_from_sensor));
+        }
+        let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
+        self.caster.cast_batch(&rays, &mut hits);
+
+        let mut extra = Vec::new();
+        let mut echoes: Vec<(f32, Hit, u32)> = Vec::with_capacity(3);
+        for (b, &(c, f, world_from_sensor)) in beams.iter().enumerate() {
+            let mc = self.layout.col_of[s][c];
+            let key = BeamKey {
+                seed: self.config.seed,
+                frame: frame as u32,
+                sensor: s as u32,
+                ring: ring as u32,
+                column: c as u32,
+            };
+            let centre = &rays[b * sub_rays];
+            echoes.clear();
+            for h in hits[b * sub_rays..(b + 1) * sub_rays].iter().flatten() {
+                echoes.push((h.t, *h, 1));
+            }
+            if sub_rays > 1 {
+                merge_echoes(&mut echoes, m.echo_separation_m);
+            }
+            let mut echo = 0u8;
+            for &(_, hit, count) in echoes.iter() {
+                if echo >= m.max_echoes {
+                    break;
+                }
+                let tri = hit.triangle as usize;
+                let surface = self.mesh.surfaces[tri];
+                let mut n_world = self.normals[tri];
+                if n_world.dot(centre.dir) > 0.0 {
+                    n_world = -n_world;
+                }
+                let cos_inc = -n_world.dot(centre.dir);
+                let Some(meas) = measure(m, hit.t, cos_inc, surface.reflectivity, &key) else { continue };
+                let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * meas.range_m;
+                // World rotation at the shot time = world_from_sensor * sensor_from_vehicle.
+                let vehicle_from_world = vehicle_from_sensor * world_from_sensor.inverse();
+                let cell = Cell {
+                    point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
+                    range_m: meas.range_m,
+                    intensity: meas.intensity * count as f32 / sub_rays as f32,
+                    class: surface.class,
+                    instance: surface.instance,
+                    normal: vehicle_from_world.transform_vector3(n_world).normalize_or_zero(),
+                    sensor: s as u8,
+                    ring: ring as u16,
+                    column: c as u32,
+                    time_s: start_time_s + f.time_s,
+                };
+                if echo == 0 {
+                    view.point[mc] = cell.point_in_vehicle;
+                    view.range[mc] = cell.range_m;
+                    view.intensity[mc] = cell.intensity;
+                    view.label[mc] = cell.class;
+                    view.instance[mc] = cell.instance;
+                    view.ground[mc] = cell.class.is_ground();
+                    view.normal[mc] = cell.normal;
+                } else {
+                    extra.push(ExtraEcho { row, col: mc, echo, cell });
+                }
+                echo += 1;
+            }
+        }
+        extra
+    }
+}
+
+/// Groups sub-beam hits (sorted by distance) into echoes at least `separation_m` apart; keeps the
+/// nearest hit of each group and counts the sub-beams in it.
+fn merge_echoes(echoes: &mut Vec<(f32, Hit, u32)>, separation_m: f32) {
+    echoes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out: Vec<(f32, Hit, u32)> = Vec::with_capacity(echoes.len());
+    for &e in echoes.iter() {
+        match out.last_mut() {
+            Some(last) if e.0 - last.0 < separation_m => last.2 += 1,
+            _ => out.push(e),
+        }
+    }
+    *echoes = out;
+}
+
+/// A return's fields, for writing a cell of a later echo plane.
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    point_in_vehicle: Vec3,
+    range_m: f32,
+    intensity: f32,
+    class: SemanticClass,
+    instance: u32,
+    normal: Vec3,
+    sensor: u8,
+    ring: u16,
+    column: u32,
+    time_s: f64,
+}
+
+impl Cell {
+    fn write(&self, cloud: &mut OrderedCloud, i: usize, echo: u8) {
+        cloud.point_in_vehicle[i] = self.point_in_vehicle;
+        cloud.range_m[i] = self.range_m;
+        cloud.intensity[i] = self.intensity;
+        cloud.label[i] = self.class;
+        cloud.instance[i] = self.instance;
+        cloud.ground[i] = self.class.is_ground();
+        cloud.normal[i] = self.normal;
+        cloud.sensor[i] = self.sensor;
+        cloud.ring[i] = self.ring;
+        cloud.column[i] = self.column;
+        cloud.time_s[i] = self.time_s;
+        cloud.echo[i] = echo;
+    }
+}
+
+/// A second or later echo, written after the parallel row pass.
+#[derive(Clone, Copy, Debug)]
+struct ExtraEcho {
+    row: usize,
+    col: usize,
+    echo: u8,
+    cell: Cell,
+}
+
+/// Mutable views of one plane-0 row of every field of a cloud.
+struct RowView<'c> {
+    point: &'c mut [Vec3],
+    range: &'c mut [f32],
+    intensity: &'c mut [f32],
+    ring: &'c mut [u16],
+    column: &'c mut [u32],
+    sensor: &'c mut [u8],
+    time: &'c mut [f64],
+    label: &'c mut [SemanticClass],
+    instance: &'c mut [u32],
+    ground: &'c mut [bool],
+    normal: &'c mut [Vec3],
+}
+
+/// Splits plane 0 of `cloud` into disjoint per-row views (for parallel filling). Requires `cols > 0`.
+fn row_views(cloud: &mut OrderedCloud) -> Vec<RowView<'_>> {
+    let n = cloud.rows * cloud.cols;
+    let cols = cloud.cols;
+    let mut point = cloud.point_in_vehicle[..n].chunks_mut(cols);
+    let mut range = cloud.range_m[..n].chunks_mut(cols);
+    let mut intensity = cloud.intensity[..n].chunks_mut(cols);
+    let mut ring = cloud.ring[..n].chunks_mut(cols);
+    let mut column = cloud.column[..n].chunks_mut(cols);
+    let mut sensor = cloud.sensor[..n].chunks_mut(cols);
+    let mut time = cloud.time_s[..n].chunks_mut(cols);
+    let mut label = cloud.label[..n].chunks_mut(cols);
+    let mut instance = cloud.instance[..n].chunks_mut(cols);
+    let mut ground = cloud.ground[..n].chunks_mut(cols);
+    let mut normal = cloud.normal[..n].chunks_mut(cols);
+    let mut views = Vec::with_capacity(cloud.rows);
+    while let (Some(p), Some(r), Some(i), Some(rg), Some(c), Some(s), Some(t), Some(l), Some(inst), Some(g), Some(nm)) = (
+        point.next(),
+        range.next(),
+        intensity.next(),
+        ring.next(),
+        column.next(),
+        sensor.next(),
+        time.next(),
+        label.next(),
+        instance.next(),
+        ground.next(),
+        normal.next(),
+    ) {
+        views.push(RowView {
+            point: p,
+            range: r,
+            intensity: i,
+            ring: rg,
+            column: c,
+            sensor: s,
+            time: t,
+            label: l,
+            instance: inst,
+            ground: g,
+            normal: nm,
+        });
+    }
+    views
+}

@@ -1,15 +1,55 @@
-//! Shared helpers of the subcommands: resolving scene and rig names or files.
+//! Shared helpers of the subcommands: resolving scene and rig names or files, and parsing lists.
 
+use anyhow::Context;
 use sim::{Rig, SceneMesh};
 
-/// Loads a scene by built-in name, bundled scene name, or TOML file path, with `seed`.
+/// A scene ready to scan: its mesh and the ground height under the ego vehicle.
+pub struct LoadedScene {
+    /// The mesh.
+    pub mesh: SceneMesh,
+    /// Ground height below the ego vehicle's start, metres.
+    pub ego_ground_z_m: f32,
+}
+
+/// Every scene name this build knows: the simulator's built-ins and the bundled library.
+pub fn scene_names() -> Vec<String> {
+    let mut names: Vec<String> = sim::scene::builtin::NAMES.iter().map(|s| s.to_string()).collect();
+    for n in scenes::bundled_names() {
+        if !names.iter().any(|k| k == n) {
+            names.push(n.to_string());
+        }
+    }
+    names
+}
+
+/// Loads a scene by bundled name, built-in name, or TOML file path, generated with `seed`.
+pub fn load_scene_full(name_or_file: &str, seed: u64) -> anyhow::Result<LoadedScene> {
+    let is_builtin = sim::scene::builtin::NAMES.contains(&name_or_file);
+    let is_bundled = scenes::bundled_names().contains(&name_or_file);
+    if is_builtin && !is_bundled {
+        return Ok(LoadedScene { mesh: sim::scene::builtin::builtin(name_or_file)?, ego_ground_z_m: 0.0 });
+    }
+    if !is_bundled && !name_or_file.ends_with(".toml") {
+        anyhow::bail!(
+            "unknown scene `{name_or_file}`; known: {} (or a path to a .toml scene file)",
+            scene_names().join(", ")
+        );
+    }
+    let scene = scenes::load(name_or_file, seed).with_context(|| format!("loading scene `{name_or_file}`"))?;
+    Ok(LoadedScene { mesh: scene.mesh, ego_ground_z_m: scene.ego_ground_z_m })
+}
+
+/// Loads a scene's mesh (see [`load_scene_full`]).
 pub fn load_scene(name_or_file: &str, seed: u64) -> anyhow::Result<SceneMesh> {
-    let _ = seed;
-    Ok(sim::scene::builtin::builtin(name_or_file)?)
+    Ok(load_scene_full(name_or_file, seed)?.mesh)
 }
 
 /// Loads a rig by preset name or TOML file path.
 pub fn load_rig(name_or_file: &str) -> anyhow::Result<Rig> {
-    let _ = name_or_file;
-    anyhow::bail!("rigs not implemented yet")
+    Rig::load(name_or_file).with_context(|| format!("loading rig `{name_or_file}`"))
+}
+
+/// Splits a comma-separated list, dropping empty items.
+pub fn split_list(s: &str) -> Vec<String> {
+    s.split(',').map(str::trim).filter(|x| !x.is_empty()).map(str::to_string).collect()
 }
