@@ -13,6 +13,7 @@ pub mod error;
 pub mod io;
 pub mod motion;
 pub mod noise;
+pub mod picture;
 pub mod rig;
 pub mod scan;
 pub mod scene;

@@ -1,0 +1,121 @@
+//! KITTI / SemanticKITTI files: `frame_NNNNNN.bin` (float32 `x y z intensity` per return, grid
+//! order = ring-major), `frame_NNNNNN.label` (uint32 per return: semantic class in the low 16 bits,
+//! instance id in the high 16 bits; instance ids above 65535 keep their low 16 bits) and, for a
+//! single-sensor rig, `frame_NNNNNN.calib.txt` with one line `Tr: r00 r01 r02 t0 r10 ... t2`, the
+//! 3 x 4 row-major `vehicle_from_sensor` transform (points in the `.bin` are then in the sensor
+//! frame, as KITTI's are; multiply by `Tr` to get vehicle-frame points). Intensity is in `[0, 1]`.
+//!
+//! The reader takes a `.bin` and optionally its `.label` and returns a `1 x N` cloud
+//! (`range_m` = distance from the origin, `column` = point index, ground = the label is a ground
+//! class).
+
+use std::path::Path;
+
+use glam::{Affine3A, Vec3};
+
+use super::read_util::read_file;
+use crate::cloud::OrderedCloud;
+use crate::error::{Result, SimError};
+use crate::scene::SemanticClass;
+
+/// Encodes the returns of `cloud` as KITTI `.bin` and `.label` bytes, transforming points by
+/// `sensor_from_vehicle` when given. Returns `(bin, label, points)`.
+pub fn encode(cloud: &OrderedCloud, sensor_from_vehicle: Option<&Affine3A>) -> Result<(Vec<u8>, Vec<u8>, usize)> {
+    cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
+    let n = cloud.returns();
+    let mut bin = Vec::with_capacity(n * 16);
+    let mut label = Vec::with_capacity(n * 4);
+    for i in (0..cloud.len()).filter(|&i| cloud.has_return(i)) {
+        let p = cloud.point_in_vehicle[i];
+        let p = sensor_from_vehicle.map_or(p, |t| t.transform_point3(p));
+        let mut rec = [0u8; 16];
+        rec[0..4].copy_from_slice(&p.x.to_le_bytes());
+        rec[4..8].copy_from_slice(&p.y.to_le_bytes());
+        rec[8..12].copy_from_slice(&p.z.to_le_bytes());
+        rec[12..16].copy_from_slice(&cloud.intensity[i].clamp(0.0, 1.0).to_le_bytes());
+        bin.extend_from_slice(&rec);
+        let l = u32::from(cloud.label[i].0) | ((cloud.instance[i] & 0xFFFF) << 16);
+        label.extend_from_slice(&l.to_le_bytes());
+    }
+    Ok((bin, label, n))
+}
+
+/// The calibration text: `Tr:` followed by the 12 row-major entries of `vehicle_from_sensor`.
+pub fn calib_text(vehicle_from_sensor: &Affine3A) -> String {
+    let m = vehicle_from_sensor.matrix3;
+    let t = vehicle_from_sensor.translation;
+    let rows = [
+        [m.x_axis.x, m.y_axis.x, m.z_axis.x, t.x],
+        [m.x_axis.y, m.y_axis.y, m.z_axis.y, t.y],
+        [m.x_axis.z, m.y_axis.z, m.z_axis.z, t.z],
+    ];
+    let vals: Vec<String> = rows.iter().flatten().map(|v| format!("{v:e}")).collect();
+    format!("Tr: {}\n", vals.join(" "))
+}
+
+/// Parses a calibration text's `Tr:` line into `vehicle_from_sensor`.
+pub fn parse_calib(path: &Path, text: &str) -> Result<Affine3A> {
+    let line = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Tr:"))
+        .ok_or_else(|| SimError::bad_file(path, "calibration has no `Tr:` line"))?;
+    let v: Vec<f32> = line
+        .split_whitespace()
+        .map(|s| s.parse::<f32>().map_err(|_| SimError::bad_file(path, format!("calibration: `{s}` is not a number"))))
+        .collect::<Result<_>>()?;
+    if v.len() != 12 || v.iter().any(|x| !x.is_finite()) {
+        return Err(SimError::bad_file(path, format!("calibration `Tr:` needs 12 finite numbers, has {}", v.len())));
+    }
+    Ok(Affine3A::from_cols_array(&[v[0], v[4], v[8], v[1], v[5], v[9], v[2], v[6], v[10], v[3], v[7], v[11]]))
+}
+
+/// Reads `bin` (and `label` if given) into a `1 x N` cloud.
+pub fn read(bin: &Path, label: Option<&Path>) -> Result<OrderedCloud> {
+    let b = read_file(bin)?;
+    let l = label.map(read_file).transpose()?;
+    read_bytes(bin, &b, label.zip(l.as_deref()))
+}
+
+/// Parses KITTI `.bin` bytes (from `bin_path`) and optional `(label_path, label_bytes)`.
+pub fn read_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<OrderedCloud> {
+    if bin.len() % 16 != 0 {
+        return Err(SimError::bad_file(
+            bin_path,
+            format!("KITTI .bin length {} is not a multiple of 16 bytes (float32 x y z intensity)", bin.len()),
+        ));
+    }
+    let n = bin.len() / 16;
+    if let Some((lp, lb)) = label {
+        if lb.len() != n * 4 {
+            return Err(SimError::bad_file(
+                lp,
+                format!(
+                    ".label holds {} bytes ({} labels{}) but {} has {n} points",
+                    lb.len(),
+                    lb.len() / 4,
+                    if lb.len() % 4 != 0 { " and a partial one" } else { "" },
+                    bin_path.display()
+                ),
+            ));
+        }
+    }
+    let mut cloud = OrderedCloud::empty(1, n, 1);
+    let f = |b: &[u8], k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
+    for (i, rec) in bin.chunks_exact(16).enumerate() {
+        let p = Vec3::new(f(rec, 0), f(rec, 4), f(rec, 8));
+        let hit = p.is_finite();
+        cloud.point_in_vehicle[i] = if hit { p } else { Vec3::NAN };
+        cloud.range_m[i] = if hit { p.length() } else { f32::NAN };
+        cloud.intensity[i] = f(rec, 12);
+        cloud.column[i] = i as u32;
+        cloud.sensor[i] = 0;
+        if let Some((_, lb)) = label {
+            let l = u32::from_le_bytes([lb[4 * i], lb[4 * i + 1], lb[4 * i + 2], lb[4 * i + 3]]);
+            let class = SemanticClass((l & 0xFFFF) as u16);
+            cloud.label[i] = class;
+            cloud.instance[i] = l >> 16;
+            cloud.ground[i] = hit && class.is_ground();
+        }
+    }
+    Ok(cloud)
+}

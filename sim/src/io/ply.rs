@@ -1,0 +1,123 @@
+//! PLY point clouds: a binary little-endian writer of a frame's returns and a reader of PLY
+//! point clouds (ours and other tools', ASCII or binary).
+//!
+//! Written vertex properties, in grid order (returns only): `x y z` (float, vehicle frame,
+//! metres), `intensity` (float, `[0, 1]`), `ring` (ushort), `time` (double, seconds), `label`
+//! (ushort, SemanticKITTI class), `instance` (uint), `ground` (uchar 0/1), `nx ny nz` (float, the
+//! true surface normal). The reader returns a `1 x N` [`OrderedCloud`]; properties the file lacks
+//! get defaults (intensity 0, ring 0, time 0, label 0, instance 0, ground = whether the label is a
+//! ground class, normal zero); `column` is the vertex index and `range_m` the distance from the origin.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::plyfile;
+use super::read_util::read_file;
+use crate::cloud::OrderedCloud;
+use crate::error::{Result, SimError};
+use crate::scene::SemanticClass;
+
+/// Bytes per written vertex.
+const VERTEX_BYTES: usize = 4 * 4 + 2 + 8 + 2 + 4 + 1 + 3 * 4;
+
+/// Encodes the returns of `cloud` as a binary little-endian PLY; returns the bytes and the count.
+pub fn encode(cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
+    cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
+    let n = cloud.returns();
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment groundtruth frame: returns in grid order, vehicle frame, \
+         metres, seconds\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty float \
+         intensity\nproperty ushort ring\nproperty double time\nproperty ushort label\nproperty uint instance\n\
+         property uchar ground\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n"
+    );
+    let mut out = Vec::with_capacity(header.len() + n * VERTEX_BYTES);
+    out.extend_from_slice(header.as_bytes());
+    for i in (0..cloud.len()).filter(|&i| cloud.has_return(i)) {
+        let p = cloud.point_in_vehicle[i];
+        let nrm = cloud.normal[i];
+        let mut rec = [0u8; VERTEX_BYTES];
+        rec[0..4].copy_from_slice(&p.x.to_le_bytes());
+        rec[4..8].copy_from_slice(&p.y.to_le_bytes());
+        rec[8..12].copy_from_slice(&p.z.to_le_bytes());
+        rec[12..16].copy_from_slice(&cloud.intensity[i].to_le_bytes());
+        rec[16..18].copy_from_slice(&cloud.ring[i].to_le_bytes());
+        rec[18..26].copy_from_slice(&cloud.time_s[i].to_le_bytes());
+        rec[26..28].copy_from_slice(&cloud.label[i].0.to_le_bytes());
+        rec[28..32].copy_from_slice(&cloud.instance[i].to_le_bytes());
+        rec[32] = u8::from(cloud.ground[i]);
+        rec[33..37].copy_from_slice(&nrm.x.to_le_bytes());
+        rec[37..41].copy_from_slice(&nrm.y.to_le_bytes());
+        rec[41..45].copy_from_slice(&nrm.z.to_le_bytes());
+        out.extend_from_slice(&rec);
+    }
+    Ok((out, n))
+}
+
+/// Writes the returns of `cloud` as a binary PLY at `path` (atomically); returns the point count.
+pub fn write(path: &Path, cloud: &OrderedCloud) -> Result<usize> {
+    let (bytes, n) = encode(cloud)?;
+    super::atomic::write_bytes_atomic(path, &bytes)?;
+    Ok(n)
+}
+
+/// Reads a PLY point cloud (the `vertex` element) into a `1 x N` cloud.
+pub fn read(path: &Path) -> Result<OrderedCloud> {
+    let bytes = read_file(path)?;
+    read_bytes(path, &bytes)
+}
+
+/// Parses PLY `bytes` (read from `path`, named in errors) into a `1 x N` cloud.
+pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
+    let header = plyfile::parse_header(path, bytes)?;
+    let ve = header
+        .elements
+        .iter()
+        .position(|e| e.name == "vertex")
+        .ok_or_else(|| SimError::bad_file(path, "PLY has no `vertex` element"))?;
+    let el = &header.elements[ve];
+    let idx = |names: &[&str]| names.iter().find_map(|n| el.scalar_index(n));
+    let (Some(ix), Some(iy), Some(iz)) = (idx(&["x"]), idx(&["y"]), idx(&["z"])) else {
+        return Err(SimError::bad_file(path, "PLY `vertex` element lacks scalar x, y or z"));
+    };
+    let i_int = idx(&["intensity", "scalar_intensity", "reflectance"]);
+    let i_ring = idx(&["ring"]);
+    let i_time = idx(&["time", "timestamp"]);
+    let i_label = idx(&["label", "class", "scalar_label"]);
+    let i_inst = idx(&["instance"]);
+    let i_ground = idx(&["ground"]);
+    let i_n = match (idx(&["nx"]), idx(&["ny"]), idx(&["nz"])) {
+        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+        _ => None,
+    };
+    let n = el.count;
+    let mut cloud = OrderedCloud::empty(1, n, 1);
+    plyfile::walk(path, bytes, &header, |e, row, s, _| {
+        if e != ve {
+            return Ok(());
+        }
+        let get = |k: Option<usize>, default: f64| k.map_or(default, |k| s[k]);
+        let p = Vec3::new(s[ix] as f32, s[iy] as f32, s[iz] as f32);
+        let hit = p.is_finite();
+        cloud.point_in_vehicle[row] = if hit { p } else { Vec3::NAN };
+        cloud.range_m[row] = if hit { p.length() } else { f32::NAN };
+        cloud.intensity[row] = get(i_int, 0.0) as f32;
+        cloud.ring[row] = get(i_ring, 0.0) as u16;
+        cloud.column[row] = row as u32;
+        cloud.sensor[row] = 0;
+        cloud.time_s[row] = get(i_time, 0.0);
+        let label = SemanticClass(get(i_label, 0.0) as u16);
+        cloud.label[row] = label;
+        cloud.instance[row] = get(i_inst, 0.0) as u32;
+        cloud.ground[row] = match i_ground {
+            Some(k) => s[k] != 0.0,
+            None => hit && label.is_ground(),
+        };
+        if let Some([a, b, c]) = i_n {
+            let nrm = Vec3::new(s[a] as f32, s[b] as f32, s[c] as f32);
+            cloud.normal[row] = if nrm.is_finite() { nrm } else { Vec3::ZERO };
+        }
+        Ok(())
+    })?;
+    Ok(cloud)
+}
