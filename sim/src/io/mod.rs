@@ -11,6 +11,7 @@ pub mod atomic;
 pub mod formats;
 pub mod kitti;
 pub mod las;
+pub mod manifest;
 pub mod pcd;
 pub mod ply;
 pub(crate) mod plyfile;
