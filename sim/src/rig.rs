@@ -1,9 +1,24 @@
-//! Rigs: one or more sensors, each with a `vehicle_from_sensor` mount. TODO(sensor helper): presets, TOML.
+//! Rigs: one or more sensors, each with a `vehicle_from_sensor` mount; the built-in presets
+//! ([`PRESETS`], see [`Rig::preset`] for every mount) and rig TOML files ([`Rig::from_toml_str`]).
+//!
+//! A rig file:
+//! ```toml
+//! name = "my-rig"                # optional, default the file stem
+//! [[sensors]]
+//! name = "front"
+//! mount = { x_m = 3.7, y_m = 0.0, z_m = 0.5, pitch_deg = 1.0 }
+//! spec = { model = "ibeo-lux", frequency_hz = 25.0 }
+//! ```
 
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::sensor::SensorSpec;
+
+mod load;
+pub mod presets;
+
+pub use presets::PRESETS;
 
 /// Where a sensor sits on the vehicle: position in metres and roll / pitch / yaw in degrees
 /// (ISO 8855 vehicle frame: x forward, y left, z up at ground level below the rear axle;
@@ -43,6 +58,7 @@ impl Mount {
 
 /// A sensor on a rig.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MountedSensor {
     /// Name unique within the rig, e.g. `front_left`.
     pub name: String,
@@ -54,8 +70,10 @@ pub struct MountedSensor {
 
 /// A set of sensors on one vehicle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Rig {
     /// Rig name (preset name or file stem).
+    #[serde(default)]
     pub name: String,
     /// The sensors; the index is the sensor id in clouds.
     pub sensors: Vec<MountedSensor>,
