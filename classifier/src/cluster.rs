@@ -12,6 +12,13 @@
 //! k-d tree's (tested against a brute-force radius clustering); the two differ only across gaps of
 //! empty cells wider than the neighbour search, where the grid version does not join.
 //!
+//! Far from the sensor, rings on the ground lie metres apart (spacing grows with the square of
+//! the range), more than any radius that still separates a car roof from the ground behind it.
+//! So grid neighbours also join when each lies within `max_plane_offset_m` of the other's tangent
+//! plane (`|n_a . (p_b - p_a)|` and `|n_b . (p_a - p_b)|`): far rings of one flat surface join,
+//! a roof 1.5 m above the ground behind it does not, however far apart they are. This link exists
+//! only between grid neighbours (0 switches it off, which gives the pure radius clustering).
+//!
 //! Rules (Sec. III-B), in order:
 //! 1. clusters with fewer than `min_cluster_points` points are noise: not ground;
 //! 2. the largest cluster is ground;
@@ -36,6 +43,8 @@ pub struct ClusterParams {
     pub link_tolerance_m: f32,
     /// Range-proportional part of the link radius (per metre of range).
     pub link_tolerance_rel: f32,
+    /// Largest offset of a grid neighbour from a candidate's tangent plane for a link, metres (0 = off).
+    pub max_plane_offset_m: f32,
     /// Clusters smaller than this are noise.
     pub min_cluster_points: usize,
     /// Clusters outside the ground area with at least this many points are ground.
@@ -53,6 +62,7 @@ impl Default for ClusterParams {
         Self {
             link_tolerance_m: 0.5,
             link_tolerance_rel: 0.05,
+            max_plane_offset_m: 0.25,
             min_cluster_points: 5,
             min_large_points: 100,
             min_large_fraction: 0.005,
@@ -71,6 +81,9 @@ impl ClusterParams {
         }
         if !(self.link_tolerance_rel.is_finite() && self.link_tolerance_rel >= 0.0) {
             return Err(ClassifyError::invalid("link_tolerance_rel", self.link_tolerance_rel, "finite, >= 0"));
+        }
+        if !(self.max_plane_offset_m.is_finite() && self.max_plane_offset_m >= 0.0) {
+            return Err(ClassifyError::invalid("max_plane_offset_m", self.max_plane_offset_m, "finite, >= 0"));
         }
         if !(self.min_large_fraction.is_finite() && (0.0..=1.0).contains(&self.min_large_fraction)) {
             return Err(ClassifyError::invalid("min_large_fraction", self.min_large_fraction, "0 ..= 1"));
@@ -113,16 +126,33 @@ fn find(parent: &mut [u32], mut i: u32) -> u32 {
     i
 }
 
-/// Clusters the candidate cells (`candidate[i]`) of `view` by conditional Euclidean clustering on
-/// the grid. Afterwards [`ClusterWorkspace::cluster_of`] gives each candidate's cluster root and
+/// Whether two candidate grid neighbours at `pa`, `pb` with unit normals `na`, `nb` join (module docs).
+#[inline]
+pub fn linked(pa: Vec3, pb: Vec3, na: Vec3, nb: Vec3, params: &ClusterParams) -> bool {
+    let d = pb - pa;
+    let tol = params.link_tolerance_m + params.link_tolerance_rel * pa.length().max(pb.length());
+    if d.length_squared() <= tol * tol {
+        return true;
+    }
+    let off = params.max_plane_offset_m;
+    off > 0.0 && na.dot(d).abs() <= off && nb.dot(d).abs() <= off
+}
+
+/// Clusters the candidate cells (`candidate[i]`, unit normals `normal[i]`) of `view` by conditional
+/// Euclidean clustering on the grid. Afterwards [`ClusterWorkspace::cluster_of`] gives each candidate's cluster root and
 /// [`ClusterWorkspace::cluster_size`] its size.
-pub fn cluster_candidates(view: &GridView<'_>, candidate: &[bool], params: &ClusterParams, ws: &mut ClusterWorkspace) {
+pub fn cluster_candidates(
+    view: &GridView<'_>,
+    candidate: &[bool],
+    normal: &[Vec3],
+    params: &ClusterParams,
+    ws: &mut ClusterWorkspace,
+) {
     let n = view.rows * view.cols;
     ws.parent.clear();
     ws.parent.extend((0..n as u32).map(|i| if candidate[i as usize] { i } else { NONE }));
     ws.size.clear();
     ws.size.resize(n, 0);
-    let (a, b) = (params.link_tolerance_m, params.link_tolerance_rel);
     for r in 0..view.rows {
         for c in 0..view.cols {
             let i = r * view.cols + c;
@@ -130,15 +160,12 @@ pub fn cluster_candidates(view: &GridView<'_>, candidate: &[bool], params: &Clus
                 continue;
             }
             let p = view.points[i];
-            let pl = p.length();
             for j in view.neighbours(r, c).into_iter().flatten() {
                 // Links are unions, so visiting a pair from both ends is harmless.
                 if ws.parent[j] == NONE || j == i {
                     continue;
                 }
-                let q = view.points[j];
-                let tol = a + b * pl.max(q.length());
-                if p.distance_squared(q) <= tol * tol {
+                if linked(p, view.points[j], normal[i], normal[j], params) {
                     let (ri, rj) = (find(&mut ws.parent, i as u32), find(&mut ws.parent, j as u32));
                     if ri != rj {
                         // Union by index keeps the result independent of visiting order details.
@@ -229,7 +256,8 @@ impl ClusterWorkspace {
         self.height_sum.resize(n, 0.0);
         for i in 0..n {
             let root = self.parent[i];
-            if root == NONE || root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points {
+            if root == NONE || root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points
+            {
                 continue;
             }
             let (x, y) = square(points[i]);

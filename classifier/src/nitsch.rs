@@ -131,7 +131,13 @@ impl Nitsch {
         if self.params.cluster {
             self.candidate.clear();
             self.candidate.extend(self.features.g_rho.iter().map(|&g| g >= thr && g > 0.0));
-            cluster_candidates(&view, &self.candidate, &self.params.clustering, &mut self.workspace);
+            cluster_candidates(
+                &view,
+                &self.candidate,
+                &self.features.normal,
+                &self.params.clustering,
+                &mut self.workspace,
+            );
             let returns = view.points.iter().filter(|p| is_valid(**p)).count();
             self.workspace.decide(view.points, returns, &self.params.clustering, &mut self.plane0_ground);
         } else {

@@ -116,8 +116,7 @@ pub fn order_points(
         }
     }
     let mut owner: Vec<Option<(u32, f32)>> = vec![None; rows * cols];
-    let mut report =
-        OrderingReport { cell_of_point: vec![None; points_in_sensor.len()], ..OrderingReport::default() };
+    let mut report = OrderingReport { cell_of_point: vec![None; points_in_sensor.len()], ..OrderingReport::default() };
     for (k, &p) in points_in_sensor.iter().enumerate() {
         let h = (p.x * p.x + p.y * p.y).sqrt();
         if !is_valid(p) || p.length_squared() == 0.0 {

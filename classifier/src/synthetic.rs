@@ -66,7 +66,13 @@ impl Shape {
                 let enter = tmin.max_element();
                 let exit = tmax.min_element();
                 if enter > 1e-4 && enter <= exit {
-                    let axis = if enter == tmin.x { 0 } else if enter == tmin.y { 1 } else { 2 };
+                    let axis = if enter == tmin.x {
+                        0
+                    } else if enter == tmin.y {
+                        1
+                    } else {
+                        2
+                    };
                     let mut n = Vec3::ZERO;
                     n[axis] = -d[axis].signum();
                     Some((enter, class, n))
@@ -160,7 +166,11 @@ impl SyntheticSensor {
 
 /// A car-sized box (class car) with its footprint centred at `(x, y)` on ground at height `z`.
 pub fn car(x: f32, y: f32, z: f32) -> Shape {
-    Shape::Aabb { min: Vec3::new(x - 2.2, y - 0.9, z), max: Vec3::new(x + 2.2, y + 0.9, z + 1.5), class: SemanticClass::CAR }
+    Shape::Aabb {
+        min: Vec3::new(x - 2.2, y - 0.9, z),
+        max: Vec3::new(x + 2.2, y + 0.9, z + 1.5),
+        class: SemanticClass::CAR,
+    }
 }
 
 /// A flat ground plane 200 m across at z = 0.
@@ -177,7 +187,11 @@ pub fn benchmark_frame() -> OrderedCloud {
         car(10.0, 3.0, 0.0),
         car(-12.0, -3.0, 0.0),
         car(20.0, -6.0, 0.0),
-        Shape::Aabb { min: Vec3::new(-50.0, 15.0, 0.0), max: Vec3::new(50.0, 20.0, 12.0), class: SemanticClass::BUILDING },
+        Shape::Aabb {
+            min: Vec3::new(-50.0, 15.0, 0.0),
+            max: Vec3::new(50.0, 20.0, 12.0),
+            class: SemanticClass::BUILDING,
+        },
     ];
     sensor.scan(&shapes)
 }

@@ -36,7 +36,12 @@ pub struct GridParams {
 
 impl Default for GridParams {
     fn default() -> Self {
-        Self { cell_m: 0.5, max_height_m: 0.15, cluster: true, nitsch: NitschParams { threshold: 0.7, ..Default::default() } }
+        Self {
+            cell_m: 0.5,
+            max_height_m: 0.15,
+            cluster: true,
+            nitsch: NitschParams { threshold: 0.7, ..Default::default() },
+        }
     }
 }
 
@@ -125,7 +130,13 @@ impl GridAccumulation {
         if self.params.cluster {
             let candidate = out[..n0].to_vec();
             let ws = &mut ClusterState::default();
-            crate::cluster::cluster_candidates(&view, &candidate, &self.params.nitsch.clustering, &mut ws.0);
+            crate::cluster::cluster_candidates(
+                &view,
+                &candidate,
+                &self.nitsch.features.normal,
+                &self.params.nitsch.clustering,
+                &mut ws.0,
+            );
             let returns = view.points.iter().filter(|p| is_valid(**p)).count();
             let mut plane0 = vec![false; n0];
             ws.0.decide(view.points, returns, &self.params.nitsch.clustering, &mut plane0);
