@@ -71,18 +71,30 @@ pub fn spinning_pattern(lasers: &[Laser], cols: usize, frequency_hz: f64) -> Sca
     let mean_u = us.iter().sum::<f64>() / rows as f64;
     let phase = mean_u - mean_u.round();
 
+    // Lasers sharing a fractional column offset (all of an OS1-128, pairs of an HDL-64E) share
+    // their per-column azimuths: compute each table of sines and cosines once.
+    let mut tables: Vec<(u64, Vec<(f64, f64)>)> = Vec::new();
     let mut firings = Vec::with_capacity(rows * cols);
     for (laser, &u) in lasers.iter().zip(&us) {
         let shift = (u - phase).round() as i64;
+        let offset = u - shift as f64;
+        let key = offset.to_bits();
+        let table_index = match tables.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                let table = (0..cols).map(|c| (PI - step_rad * (c as f64 + offset)).sin_cos()).collect();
+                tables.push((key, table));
+                tables.len() - 1
+            }
+        };
+        let trig = &tables[table_index].1;
         let (sin_el, cos_el) = laser.elevation_rad.sin_cos();
         let [ox, oy, oz] = laser.origin_in_head_m;
         let has_origin = ox != 0.0 || oy != 0.0 || oz != 0.0;
-        for c in 0..cols {
-            let k = c as i64 - shift;
-            let k_wrapped = k.rem_euclid(cols as i64);
+        for (c, &(sin_az, cos_az)) in trig.iter().enumerate() {
+            // Beam azimuth = pi - step * (k + u) with k = c - shift: the table entry of column c.
+            let k_wrapped = (c as i64 - shift).rem_euclid(cols as i64);
             let time_s = k_wrapped as f64 * cycle_s + laser.time_offset_s;
-            let azimuth_rad = PI - step_rad * (k as f64 + u);
-            let (sin_az, cos_az) = azimuth_rad.sin_cos();
             let dir = Vec3::new((cos_el * cos_az) as f32, (cos_el * sin_az) as f32, sin_el as f32);
             let origin = if has_origin {
                 Vec3::new((ox * cos_az - oy * sin_az) as f32, (ox * sin_az + oy * cos_az) as f32, oz as f32)

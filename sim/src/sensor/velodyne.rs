@@ -44,7 +44,7 @@ impl Default for Vlp16Spec {
 impl Vlp16Spec {
     /// Elevation of firing slot `n` (0..16) of the interleaved order, degrees.
     pub fn slot_elevation_deg(n: usize) -> f64 {
-        if n % 2 == 0 { n as f64 - 15.0 } else { n as f64 }
+        if n.is_multiple_of(2) { n as f64 - 15.0 } else { n as f64 }
     }
 
     /// Number of columns at this rotation rate.
