@@ -36,7 +36,9 @@ pub fn header(text: &str, source_name: &str) -> Result<Header, SceneError> {
             });
         }
         Some(toml::Value::Integer(VERSION)) => {}
-        Some(toml::Value::Integer(v)) => return Err(SceneError::Version { source_name: source_name.into(), version: v }),
+        Some(toml::Value::Integer(v)) => {
+            return Err(SceneError::Version { source_name: source_name.into(), version: v });
+        }
         Some(other) => {
             return Err(SceneError::Toml {
                 source_name: source_name.into(),
@@ -92,10 +94,8 @@ pub enum ClassSpec {
 impl ClassSpec {
     /// The class, or an error naming `field` and the known names.
     pub fn resolve(&self, field: &str) -> Result<sim::SemanticClass, SceneError> {
-        let known: Vec<sim::SemanticClass> = (0..=u16::from(u8::MAX))
-            .map(sim::SemanticClass)
-            .filter(|c| c.name() != "other")
-            .collect();
+        let known: Vec<sim::SemanticClass> =
+            (0..=u16::from(u8::MAX)).map(sim::SemanticClass).filter(|c| c.name() != "other").collect();
         let found = match self {
             ClassSpec::Id(id) => known.iter().find(|c| c.0 == *id),
             ClassSpec::Name(n) => known.iter().find(|c| c.name() == n),

@@ -44,11 +44,8 @@ pub fn load_placed(entry: &MeshEntry, k: usize, base_dir: &Path, instance: u32) 
         entry.pitch_deg.to_radians(),
         entry.roll_deg.to_radians(),
     );
-    let world_from_local = Affine3A::from_scale_rotation_translation(
-        Vec3::splat(entry.scale),
-        rot,
-        Vec3::from_array(entry.position),
-    );
+    let world_from_local =
+        Affine3A::from_scale_rotation_translation(Vec3::splat(entry.scale), rot, Vec3::from_array(entry.position));
     let surface = Surface { class, instance, reflectivity };
     let mut out = SceneMesh::new();
     out.vertices.extend(raw.vertices.iter().map(|&v| world_from_local.transform_point3(v)));
@@ -63,10 +60,9 @@ fn read_obj(path: &Path) -> Result<SceneMesh, SceneError> {
     let err = |message: String| SceneError::MeshFile { path: path.to_path_buf(), message };
     let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let (models, _materials) = tobj::load_obj_buf(&mut std::io::BufReader::new(file), &opts, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| err(format!("not a readable OBJ file: {e}")))?;
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut std::io::BufReader::new(file), &opts, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| err(format!("not a readable OBJ file: {e}")))?;
     let mut mesh = SceneMesh::new();
     for model in models {
         let m = &model.mesh;
@@ -86,11 +82,10 @@ fn read_obj(path: &Path) -> Result<SceneMesh, SceneError> {
     Ok(mesh)
 }
 
-/// Reads a PLY mesh. `sim::scene::ply::read_mesh` is being written in parallel; until it exists
-/// this returns a clear error naming the file.
+/// Reads a PLY mesh (binary or ASCII) with `sim::scene::ply`; its own labels are replaced by the entry's.
 fn read_ply(path: &Path) -> Result<SceneMesh, SceneError> {
-    Err(SceneError::MeshFile {
+    sim::scene::ply::read_mesh(path).map_err(|e| SceneError::MeshFile {
         path: path.to_path_buf(),
-        message: "PLY user meshes are not supported by this build yet (use OBJ)".into(),
+        message: format!("not a readable PLY mesh: {e}"),
     })
 }

@@ -29,7 +29,10 @@ fn every_bundled_scene_is_valid_deterministic_and_labelled() {
         assert!((10_000..1_500_000).contains(&n), "{name}: {n} triangles");
         let ground = a.mesh.surfaces.iter().filter(|s| s.class.is_ground()).count();
         assert!(ground > 1000 && ground < n, "{name}: {ground} ground of {n}");
-        assert!(a.mesh.surfaces.iter().filter(|s| s.class.is_ground()).all(|s| s.instance == 0), "{name}: ground is stuff");
+        assert!(
+            a.mesh.surfaces.iter().filter(|s| s.class.is_ground()).all(|s| s.instance == 0),
+            "{name}: ground is stuff"
+        );
         let objects: std::collections::BTreeSet<u32> = a.mesh.surfaces.iter().map(|s| s.instance).collect();
         assert!(objects.len() > 2, "{name}: {} instances", objects.len());
         let b = scenes::load(name, 0).unwrap();

@@ -6,12 +6,16 @@ use glam::Vec3;
 use sim::SemanticClass;
 
 fn ramp_toml(slope_deg: f32, sides: &str) -> String {
-    format!("version = 1\nfamily = \"ramp\"\n[params]\nslope_deg = {slope_deg}\nlength_m = 25.0\ndistance_m = 12.0\nwidth_m = 6.0\nsides = \"{sides}\"\n")
+    format!(
+        "version = 1\nfamily = \"ramp\"\n[params]\nslope_deg = {slope_deg}\nlength_m = 25.0\ndistance_m = 12.0\nwidth_m = 6.0\nsides = \"{sides}\"\n"
+    )
 }
 
 #[test]
 fn ramp_slope_on_the_mesh_equals_the_requested_slope() {
-    for (slope, sides) in [(-20.0f32, "walls"), (-12.5, "railings"), (-3.0, "none"), (4.0, "walls"), (12.0, "railings"), (20.0, "walls")] {
+    for (slope, sides) in
+        [(-20.0f32, "walls"), (-12.5, "railings"), (-3.0, "none"), (4.0, "walls"), (12.0, "railings"), (20.0, "walls")]
+    {
         let s = scenes::load_str(&ramp_toml(slope, sides), "test", std::path::Path::new("."), 0).unwrap();
         let m = &s.mesh;
         let mut n = 0;
@@ -49,7 +53,9 @@ fn ramp_slope_on_the_mesh_equals_the_requested_slope() {
 #[test]
 fn basin_depth_on_the_mesh_equals_the_requested_depth() {
     for depth in [0.5f32, 2.0, 4.5] {
-        let text = format!("version = 1\nfamily = \"basin\"\n[params]\ndepth_m = {depth}\nbottom_width_m = 6.0\nbank_slope_deg = 25.0\n");
+        let text = format!(
+            "version = 1\nfamily = \"basin\"\n[params]\ndepth_m = {depth}\nbottom_width_m = 6.0\nbank_slope_deg = 25.0\n"
+        );
         let s = scenes::load_str(&text, "test", std::path::Path::new("."), 0).unwrap();
         let m = &s.mesh;
         // Default geometry: road 7 m, shoulder 2 m, basin on the right (-y).
@@ -95,7 +101,8 @@ fn city_curbs_have_the_requested_height_and_markings_are_coplanar() {
     assert_eq!(road.class, SemanticClass::ROAD);
     assert_eq!(walk.class, SemanticClass::SIDEWALK);
     assert!((z_walk - z_road - 0.14).abs() < 1e-5);
-    let marks: Vec<usize> = (0..s.mesh.len()).filter(|&i| s.mesh.surfaces[i].class == SemanticClass::LANE_MARKING).collect();
+    let marks: Vec<usize> =
+        (0..s.mesh.len()).filter(|&i| s.mesh.surfaces[i].class == SemanticClass::LANE_MARKING).collect();
     assert!(marks.len() > 100);
     for i in marks {
         assert!(s.mesh.triangle(i).iter().all(|v| v.z == 0.0));
@@ -109,7 +116,11 @@ fn highway_has_markings_in_the_road_plane_and_traffic() {
     let m = &s.mesh;
     let marks = (0..m.len()).filter(|&i| m.surfaces[i].class == SemanticClass::LANE_MARKING).count();
     assert!(marks > 1000, "{marks}");
-    assert!((0..m.len()).filter(|&i| m.surfaces[i].class == SemanticClass::LANE_MARKING).all(|i| m.triangle(i).iter().all(|v| v.z == 0.0)));
+    assert!(
+        (0..m.len())
+            .filter(|&i| m.surfaces[i].class == SemanticClass::LANE_MARKING)
+            .all(|i| m.triangle(i).iter().all(|v| v.z == 0.0))
+    );
     let vehicles: std::collections::BTreeSet<u32> = m
         .surfaces
         .iter()
@@ -136,7 +147,8 @@ fn bush_count(name: &str) -> usize {
 
 #[test]
 fn forest_presets_follow_seed_002_sparse_has_no_bushes_dense_is_cluttered() {
-    let (sparse, moderate, dense) = (bush_count("forest-sparse"), bush_count("forest-moderate"), bush_count("forest-dense"));
+    let (sparse, moderate, dense) =
+        (bush_count("forest-sparse"), bush_count("forest-moderate"), bush_count("forest-dense"));
     assert_eq!(sparse, 0);
     assert!(moderate > 500, "{moderate}");
     assert!(dense > 3 * moderate, "{dense} vs {moderate}");
@@ -150,7 +162,8 @@ fn forest_terrain_is_uneven_but_gently_sloped() {
     let max_slope = ground.iter().map(|&i| m.triangle_normal(i).z.acos().to_degrees()).fold(0.0f32, f32::max);
     let zs: Vec<f32> = m.vertices.iter().map(|v| v.z).collect();
     assert!(max_slope > 1.0 && max_slope < 15.0, "max slope {max_slope}");
-    let (lo, hi) = ground.iter().flat_map(|&i| m.triangle(i)).fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(v.z), h.max(v.z)));
+    let (lo, hi) =
+        ground.iter().flat_map(|&i| m.triangle(i)).fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(v.z), h.max(v.z)));
     assert!(hi - lo > 0.5 && hi - lo < 3.0, "relief {lo} .. {hi}");
     assert!(!zs.is_empty());
 }

@@ -110,7 +110,8 @@ impl Family for Params {
         let mut edges = vec![-reach];
         edges.extend(cross_x.iter().flat_map(|cx| [cx - hw - sw, cx + hw + sw]));
         edges.push(reach);
-        let blocks: Vec<(f32, f32)> = edges.chunks_exact(2).map(|c| (c[0], c[1])).filter(|(a, b)| b - a > 8.0).collect();
+        let blocks: Vec<(f32, f32)> =
+            edges.chunks_exact(2).map(|c| (c[0], c[1])).filter(|(a, b)| b - a > 8.0).collect();
         for &(x0, x1) in &blocks {
             for side in [-1.0f32, 1.0] {
                 // Buildings along the block face, set back 1 m from the sidewalk.
@@ -120,7 +121,13 @@ impl Family for Params {
                     let depth = r.random_range(12.0..20.0f32);
                     let height = r.random_range(8.0..30.0f32);
                     let y = side * (hw + sw + 1.0 + 0.5 * depth);
-                    objects::building(&mut mesh, &mut ids, Vec3::new(x + 0.5 * len, y, curb), 0.0, Vec3::new(len, depth, height));
+                    objects::building(
+                        &mut mesh,
+                        &mut ids,
+                        Vec3::new(x + 0.5 * len, y, curb),
+                        0.0,
+                        Vec3::new(len, depth, height),
+                    );
                     x += len + r.random_range(1.0..4.0f32);
                 }
                 // Parked cars along the curb, street furniture on the sidewalk.
@@ -145,7 +152,11 @@ impl Family for Params {
                 }
                 let peds = (self.pedestrians_per_100m * (x1 - x0) / 100.0).round() as u32;
                 for _ in 0..peds {
-                    let p = Vec3::new(r.random_range(x0 + 1.0..x1 - 1.0), side * r.random_range(hw + 1.2..hw + sw - 0.5), curb);
+                    let p = Vec3::new(
+                        r.random_range(x0 + 1.0..x1 - 1.0),
+                        side * r.random_range(hw + 1.2..hw + sw - 0.5),
+                        curb,
+                    );
                     objects::pedestrian(&mut mesh, &mut ids, p, r.random_range(0.0..std::f32::consts::TAU));
                 }
             }

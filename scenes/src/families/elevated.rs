@@ -63,7 +63,9 @@ impl Family for Params {
         let yb: Vec<f32> = edges.iter().flat_map(|e| e.1).collect();
         let xs = axis(half, 70.0, 1.0, 2.0, &xb, &[]);
         let ys = axis(half, 70.0, 1.0, 2.0, &yb, &[]);
-        let height = |x: f32, y: f32| edges.iter().map(|(ex, ey)| h * trapezoid(x, *ex).min(trapezoid(y, *ey))).fold(0.0, f32::max);
+        let height = |x: f32, y: f32| {
+            edges.iter().map(|(ex, ey)| h * trapezoid(x, *ex).min(trapezoid(y, *ey))).fold(0.0, f32::max)
+        };
         let mut mesh = SceneMesh::new();
         Grid::new(xs, ys).push(&mut mesh, height, |c| {
             let class = if c.z_max > 0.0 {

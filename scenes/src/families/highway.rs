@@ -121,16 +121,34 @@ impl Family for Params {
         }
         let mut ybreaks: Vec<f32> = bands.iter().flat_map(|b| [b.0, b.1]).collect();
         let (bl, bh) = (sec.bank_right, sec.bank_left);
-        ybreaks.extend([sec.right_edge, sec.left_edge, sec.opp_right, sec.opp_left, bl, bl - sec.run, bh, bh + sec.run]);
+        ybreaks.extend([
+            sec.right_edge,
+            sec.left_edge,
+            sec.opp_right,
+            sec.opp_left,
+            bl,
+            bl - sec.run,
+            bh,
+            bh + sec.run,
+        ]);
         let xs = axis(half, 80.0, 1.0, 2.0, &[], &[]);
         let ys = axis(half, 40.0, 1.0, 2.0, &ybreaks, &[]);
         let h = self.embankment_height_m;
         let run = sec.run.max(1e-6);
         let height = move |_: f32, y: f32| {
-            let out = if y < bl { (bl - y) / run } else if y > bh { (y - bh) / run } else { 0.0 };
+            let out = if y < bl {
+                (bl - y) / run
+            } else if y > bh {
+                (y - bh) / run
+            } else {
+                0.0
+            };
             -h * out.min(1.0)
         };
-        let on_road = |y: f32| (sec.right_edge - 2.5..sec.left_edge + 1.0).contains(&y) || (sec.opp_right - 1.0..sec.opp_left + 2.5).contains(&y);
+        let on_road = |y: f32| {
+            (sec.right_edge - 2.5..sec.left_edge + 1.0).contains(&y)
+                || (sec.opp_right - 1.0..sec.opp_left + 2.5).contains(&y)
+        };
         let mut mesh = SceneMesh::new();
         Grid::new(xs, ys).push(&mut mesh, height, |c| {
             let marked = bands.iter().any(|&(lo, hi, dashed)| {
@@ -148,35 +166,46 @@ impl Family for Params {
         let mut ids = Ids::default();
         let ext = half - 2.0;
         objects::wall(&mut mesh, &mut ids, Vec3::new(0.0, sec.median_y, 0.0), 0.0, Vec3::new(2.0 * ext, 0.5, 0.9));
-        objects::guard_rail(&mut mesh, &mut ids, Vec3::new(-ext, sec.rail_right, 0.0), Vec3::new(ext, sec.rail_right, 0.0));
-        objects::guard_rail(&mut mesh, &mut ids, Vec3::new(ext, sec.rail_left, 0.0), Vec3::new(-ext, sec.rail_left, 0.0));
+        objects::guard_rail(
+            &mut mesh,
+            &mut ids,
+            Vec3::new(-ext, sec.rail_right, 0.0),
+            Vec3::new(ext, sec.rail_right, 0.0),
+        );
+        objects::guard_rail(
+            &mut mesh,
+            &mut ids,
+            Vec3::new(ext, sec.rail_left, 0.0),
+            Vec3::new(-ext, sec.rail_left, 0.0),
+        );
         let mut r = rng(seed, 5);
         let mean_gap = (1000.0 / self.vehicles_per_km.max(1e-3)).max(self.min_gap_m);
-        let mut lane_traffic = |mesh: &mut SceneMesh, ids: &mut Ids, y: f32, yaw: f32, per_km_scale: f32, ego_lane: bool| {
-            if self.vehicles_per_km == 0.0 {
-                return;
-            }
-            let mut x = -ext + r.random_range(0.0..mean_gap);
-            while x < ext - 8.0 {
-                let kind = r.random_range(0..20u32);
-                let len = match kind {
-                    0..=13 => 4.5,
-                    14..=16 => 5.2,
-                    _ => 12.0,
-                };
-                let c = x + 0.5 * len;
-                if !(ego_lane && c.abs() < 0.5 * len + 6.0) {
-                    let p = Vec3::new(c, y, 0.0);
-                    match kind {
-                        0..=13 => objects::car(mesh, ids, p, yaw),
-                        14..=16 => objects::van(mesh, ids, p, yaw),
-                        _ => objects::truck(mesh, ids, p, yaw),
-                    };
+        let mut lane_traffic =
+            |mesh: &mut SceneMesh, ids: &mut Ids, y: f32, yaw: f32, per_km_scale: f32, ego_lane: bool| {
+                if self.vehicles_per_km == 0.0 {
+                    return;
                 }
-                let gap = self.min_gap_m + r.random_range(0.0..2.0f32) * (mean_gap - self.min_gap_m) / per_km_scale;
-                x += len + gap;
-            }
-        };
+                let mut x = -ext + r.random_range(0.0..mean_gap);
+                while x < ext - 8.0 {
+                    let kind = r.random_range(0..20u32);
+                    let len = match kind {
+                        0..=13 => 4.5,
+                        14..=16 => 5.2,
+                        _ => 12.0,
+                    };
+                    let c = x + 0.5 * len;
+                    if !(ego_lane && c.abs() < 0.5 * len + 6.0) {
+                        let p = Vec3::new(c, y, 0.0);
+                        match kind {
+                            0..=13 => objects::car(mesh, ids, p, yaw),
+                            14..=16 => objects::van(mesh, ids, p, yaw),
+                            _ => objects::truck(mesh, ids, p, yaw),
+                        };
+                    }
+                    let gap = self.min_gap_m + r.random_range(0.0..2.0f32) * (mean_gap - self.min_gap_m) / per_km_scale;
+                    x += len + gap;
+                }
+            };
         for k in 0..self.lanes {
             let y = sec.right_edge + (k as f32 + 0.5) * lw;
             lane_traffic(&mut mesh, &mut ids, y, 0.0, 1.0, k == 1);

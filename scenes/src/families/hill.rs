@@ -126,7 +126,10 @@ impl Family for Params {
             return Err(SceneError::invalid(
                 "params.crest_length_m",
                 self.crest_length_m,
-                format!("<= 2 * (crest_x_m - 5) = {} (the ego vehicle stands on the slope)", 2.0 * (self.crest_x_m - 5.0)),
+                format!(
+                    "<= 2 * (crest_x_m - 5) = {} (the ego vehicle stands on the slope)",
+                    2.0 * (self.crest_x_m - 5.0)
+                ),
             ));
         }
         if 0.5 * (self.crest_length_m + self.dip_length_m) > self.dip_distance_m {
@@ -172,7 +175,8 @@ impl Family for Params {
             let mut car = SceneMesh::new();
             objects::car(&mut car, &mut ids, Vec3::ZERO, yaw);
             let pitch = prof.gradient(x).atan();
-            let at = Affine3A::from_rotation_translation(Quat::from_rotation_y(-pitch), Vec3::new(x, y, prof.height(x)));
+            let at =
+                Affine3A::from_rotation_translation(Quat::from_rotation_y(-pitch), Vec3::new(x, y, prof.height(x)));
             mesh.append_transformed(&car, at);
         }
         Generated { mesh, ego_ground_z_m: 0.0, ids }

@@ -69,12 +69,7 @@ fn run<P: Family>(text: &str, source: &str, seed: u64) -> Result<(Generated, Vec
 }
 
 /// Parses the family's parameters from `text` and generates the scene.
-pub fn generate(
-    family: &str,
-    text: &str,
-    source: &str,
-    seed: u64,
-) -> Result<(Generated, Vec<MeshEntry>), SceneError> {
+pub fn generate(family: &str, text: &str, source: &str, seed: u64) -> Result<(Generated, Vec<MeshEntry>), SceneError> {
     match family {
         "flat" => run::<flat::Params>(text, source, seed),
         "ramp" => run::<ramp::Params>(text, source, seed),

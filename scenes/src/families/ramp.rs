@@ -147,8 +147,20 @@ impl Family for Params {
                     let id = ids.fresh();
                     let s = Surface::object(SemanticClass::FENCE, id);
                     let depth = h_end + 0.3;
-                    sheared_box(&mut mesh, Vec3::new(x0, y, 0.0), Vec3::new(x1, y, h_end), (-depth, self.wall_height_m), s);
-                    sheared_box(&mut mesh, Vec3::new(x1, y, h_end), Vec3::new(xe, y, h_end), (-depth, self.wall_height_m), s);
+                    sheared_box(
+                        &mut mesh,
+                        Vec3::new(x0, y, 0.0),
+                        Vec3::new(x1, y, h_end),
+                        (-depth, self.wall_height_m),
+                        s,
+                    );
+                    sheared_box(
+                        &mut mesh,
+                        Vec3::new(x1, y, h_end),
+                        Vec3::new(xe, y, h_end),
+                        (-depth, self.wall_height_m),
+                        s,
+                    );
                 }
                 Sides::Walls => {
                     let id = ids.fresh();
@@ -162,7 +174,12 @@ impl Family for Params {
         let front_top = if up { h_end + 3.0 } else { 3.0 };
         let front_bottom = if up { h_end + 2.4 } else { 0.0 };
         if front_top > front_bottom {
-            objects::slab(&mut mesh, &mut ids, Vec3::new(xe, -hw - 4.0, front_bottom), Vec3::new(xe + 0.4, hw + 4.0, front_top));
+            objects::slab(
+                &mut mesh,
+                &mut ids,
+                Vec3::new(xe, -hw - 4.0, front_bottom),
+                Vec3::new(xe + 0.4, hw + 4.0, front_top),
+            );
         }
         Generated { mesh, ego_ground_z_m: 0.0, ids }
     }

@@ -73,10 +73,7 @@ impl Params {
 
     fn basin_edges(&self) -> ([f32; 4], [f32; 4]) {
         let r = BASIN_RUN_PER_DEPTH * self.basin_depth_m;
-        (
-            [BASIN_X.0, BASIN_X.0 + r, BASIN_X.1 - r, BASIN_X.1],
-            [BASIN_Y.0, BASIN_Y.0 + r, BASIN_Y.1 - r, BASIN_Y.1],
-        )
+        ([BASIN_X.0, BASIN_X.0 + r, BASIN_X.1 - r, BASIN_X.1], [BASIN_Y.0, BASIN_Y.0 + r, BASIN_Y.1 - r, BASIN_Y.1])
     }
 }
 
