@@ -19,7 +19,7 @@
 //! sequence), so column 0 is centred within half a column of +180 deg. The firing of
 //! a laser placed in column `c` is the one whose beam azimuth falls in that bin: cycle
 //! `k = c - round(u - phase)`, taken modulo `cols` so that its time lies inside the frame
-//! (`time_s = (k mod cols) * cycle + tau`). Its direction uses the true beam azimuth, which lies
+//! (`time_s = ((k mod cols) * cycle + tau) mod period`). Its direction uses the true beam azimuth, which lies
 //! within half a column of the bin centre, and the exact table elevation. Neighbouring cells of the
 //! grid are therefore neighbouring beams in space even when a sensor's lasers are staggered in
 //! azimuth by many columns (HDL-64E: -8.5 .. +9.9 deg = about -49 .. +57 columns at 10 Hz).
@@ -94,7 +94,10 @@ pub fn spinning_pattern(lasers: &[Laser], cols: usize, frequency_hz: f64) -> Sca
         for (c, &(sin_az, cos_az)) in trig.iter().enumerate() {
             // Beam azimuth = pi - step * (k + u) with k = c - shift: the table entry of column c.
             let k_wrapped = (c as i64 - shift).rem_euclid(cols as i64);
-            let time_s = k_wrapped as f64 * cycle_s + laser.time_offset_s;
+            // A time offset longer than a cycle pushes late firings past the frame end: they are
+            // the same beams one revolution earlier.
+            let t = (k_wrapped as f64 * cycle_s + laser.time_offset_s).rem_euclid(period_s);
+            let time_s = if t < period_s { t } else { 0.0 };
             let dir = Vec3::new((cos_el * cos_az) as f32, (cos_el * sin_az) as f32, sin_el as f32);
             let origin = if has_origin {
                 Vec3::new((ox * cos_az - oy * sin_az) as f32, (ox * sin_az + oy * cos_az) as f32, oz as f32)
