@@ -178,3 +178,12 @@ fn file_seed_and_caller_seed_add_up() {
     assert_eq!(a.seed, 5);
     assert_eq!(a.mesh, b);
 }
+
+#[test]
+fn absurd_sizes_are_refused_before_generating() {
+    let e = load("version = 1\nfamily = \"flat\"\n[params]\nsize_m = 2000.0\ncell_m = 0.25\n").unwrap_err();
+    assert!(matches!(&e, SceneError::InvalidParameter { field, .. } if field == "params.cell_m"), "{e:?}");
+    let e =
+        load("version = 1\nfamily = \"forest-dense\"\n[params]\nsize_m = 600.0\nshrubs_per_ha = 5000.0\n").unwrap_err();
+    assert!(e.to_string().contains("shrubs_per_ha"), "{e}");
+}

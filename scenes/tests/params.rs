@@ -41,7 +41,7 @@ fn ramp_slope_on_the_mesh_equals_the_requested_slope() {
         assert!(land.class.is_ground());
         // Walls or railings beside the corridor; with no side structures a descending corridor
         // has plain ground beside it.
-        let (_, beside) = common::hit_below(m, 24.5, 3.2, 10.0).unwrap();
+        let (_, beside) = common::hit_below(m, 24.5, 3.1, 10.0).unwrap();
         if sides == "none" && slope < 0.0 {
             assert_eq!(beside.class, SemanticClass::OTHER_GROUND, "slope {slope}");
         } else {

@@ -11,6 +11,9 @@ use crate::error::{SceneError, check, check_count};
 use crate::grid::{Grid, axis};
 use crate::objects::{self, Ids};
 
+/// Most ground triangles a `flat` scene may have.
+const MAX_TRIANGLES: f32 = 4_000_000.0;
+
 /// Parameters of `flat`.
 #[derive(Deserialize, Debug, Clone)]
 #[serde(default, deny_unknown_fields)]
@@ -36,7 +39,19 @@ impl Family for Params {
         check("size_m", self.size_m, 100.0, 2000.0)?;
         check("cell_m", self.cell_m, 0.25, 5.0)?;
         check("road_width_m", self.road_width_m, 0.0, 40.0)?;
-        check_count("objects", self.objects, 0, 500)
+        check_count("objects", self.objects, 0, 500)?;
+        let cells = (self.size_m / self.cell_m).ceil();
+        if 2.0 * cells * cells > MAX_TRIANGLES {
+            return Err(SceneError::invalid(
+                "params.cell_m",
+                self.cell_m,
+                format!(
+                    ">= size_m / {} (at most {MAX_TRIANGLES} ground triangles)",
+                    (0.5 * MAX_TRIANGLES).sqrt().floor()
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn build(&self, seed: u64) -> Generated {

@@ -25,6 +25,9 @@ use crate::grid::{Grid, axis};
 use crate::noise::Fbm;
 use crate::objects::{self, Ids};
 
+/// Most objects (trees + bushes + shrubs) a forest may hold (about 4 M triangles).
+const MAX_OBJECTS: f32 = 40_000.0;
+
 /// Parameters shared by the three forest families; every field defaults to its preset's value.
 #[derive(Deserialize, Debug, Clone, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -96,7 +99,16 @@ impl Params {
         check("trees_per_ha", r.trees_per_ha, 0.0, 1000.0)?;
         check("bushes_per_ha", r.bushes_per_ha, 0.0, 3000.0)?;
         check("shrubs_per_ha", r.shrubs_per_ha, 0.0, 5000.0)?;
-        check("clearing_m", r.clearing_m, 1.0, 20.0)
+        check("clearing_m", r.clearing_m, 1.0, 20.0)?;
+        let objects = (r.trees_per_ha + r.bushes_per_ha + r.shrubs_per_ha) * r.size_m * r.size_m / 10_000.0;
+        if objects > MAX_OBJECTS {
+            return Err(SceneError::invalid(
+                "params.trees_per_ha + bushes_per_ha + shrubs_per_ha",
+                objects.round(),
+                format!("at most {MAX_OBJECTS} objects over size_m^2 (lower the densities or size_m)"),
+            ));
+        }
+        Ok(())
     }
 
     fn generate(&self, preset: Preset, seed: u64) -> Generated {

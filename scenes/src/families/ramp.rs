@@ -131,7 +131,9 @@ impl Family for Params {
         let mut ids = Ids::default();
         let h_end = self.profile_z(x1);
         for side in [-1.0f32, 1.0] {
-            let y = side * (hw + 0.15);
+            // Walls stand flush against the corridor edge (0.2 m thick, outside it); railing posts
+            // stand 0.15 m outside it.
+            let y = side * (hw + if self.sides == Sides::Walls { 0.1 } else { 0.15 });
             match self.sides {
                 Sides::None => {}
                 Sides::Railings if up => {
