@@ -130,12 +130,13 @@ fn find(parent: &mut [u32], mut i: u32) -> u32 {
 #[inline]
 pub fn linked(pa: Vec3, pb: Vec3, na: Vec3, nb: Vec3, params: &ClusterParams) -> bool {
     let d = pb - pa;
-    let tol = params.link_tolerance_m + params.link_tolerance_rel * pa.length().max(pb.length());
-    if d.length_squared() <= tol * tol {
+    // The tangent-plane test first: it needs no square root and joins most ground links.
+    let off = params.max_plane_offset_m;
+    if off > 0.0 && na.dot(d).abs() <= off && nb.dot(d).abs() <= off {
         return true;
     }
-    let off = params.max_plane_offset_m;
-    off > 0.0 && na.dot(d).abs() <= off && nb.dot(d).abs() <= off
+    let tol = params.link_tolerance_m + params.link_tolerance_rel * pa.length_squared().max(pb.length_squared()).sqrt();
+    d.length_squared() <= tol * tol
 }
 
 /// Clusters the candidate cells (`candidate[i]`, unit normals `normal[i]`) of `view` by conditional
@@ -160,8 +161,14 @@ pub fn cluster_candidates(
                 continue;
             }
             let p = view.points[i];
-            for j in view.neighbours(r, c).into_iter().flatten() {
-                // Links are unions, so visiting a pair from both ends is harmless.
+            // Interior cells with all direct neighbours: the relation is symmetric, so the four
+            // forward neighbours (d1, d2, d3 and d8: up, up-right, right, up-left) cover every link.
+            // Elsewhere all found neighbours are linked (unions are idempotent).
+            let nbs = match view.direct_neighbours(r, c) {
+                Some(d) => [Some(d[0]), Some(d[1]), Some(d[2]), Some(d[7]), None, None, None, None],
+                None => view.neighbours(r, c),
+            };
+            for j in nbs.into_iter().flatten() {
                 if ws.parent[j] == NONE || j == i {
                     continue;
                 }

@@ -62,6 +62,8 @@ impl Default for NeighbourParams {
 pub struct GridView<'a> {
     /// Points of the plane, row-major, NaN where no return.
     pub points: &'a [Vec3],
+    /// Measured range per cell, metres (NaN where unknown: the occlusion test is then skipped).
+    pub ranges: &'a [f32],
     /// Rows.
     pub rows: usize,
     /// Columns.
@@ -118,12 +120,31 @@ impl<'a> GridView<'a> {
         None
     }
 
+    /// Fast path: the 8 direct neighbours (order `d1..d8`) of an interior cell when all hold
+    /// returns; then they are exactly what [`GridView::neighbours`] returns, and each of them has
+    /// the cell among its own neighbours (the relation is symmetric).
+    #[inline]
+    pub fn direct_neighbours(&self, r: usize, c: usize) -> Option<[usize; 8]> {
+        let cols = self.cols;
+        if r > 0 && r + 1 < self.rows && c > 0 && c + 1 < cols {
+            let i = r * cols + c;
+            let idx = [i + cols, i + cols + 1, i + 1, i - cols + 1, i - cols, i - cols - 1, i - 1, i + cols - 1];
+            if idx.iter().all(|&j| is_valid(self.points[j])) {
+                return Some(idx);
+            }
+        }
+        None
+    }
+
     /// Cell indices (within the plane) of the 8 neighbours of `(r, c)` in the order `d1..d8` of the
     /// module docs; `None` where missing (distance threshold not applied here).
     #[inline]
     pub fn neighbours(&self, r: usize, c: usize) -> [Option<usize>; 8] {
-        let mut out = [None; 8];
         let cols = self.cols;
+        if let Some(idx) = self.direct_neighbours(r, c) {
+            return idx.map(Some);
+        }
+        let mut out = [None; 8];
         if r + 1 < self.rows {
             let up = r + 1;
             if let Some(cc) = self.nearest_in_row(up, c) {
@@ -156,17 +177,17 @@ pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
         return false;
     }
     let col_azimuth = |c: usize| -> Option<f32> {
-        let mut best: Option<(f32, f32)> = None;
+        let mut best: Option<(f32, Vec3)> = None;
         for r in 0..rows {
             let p = points[r * cols + c];
             if is_valid(p) {
                 let d2 = p.x * p.x + p.y * p.y;
                 if best.is_none_or(|(bd, _)| d2 > bd) {
-                    best = Some((d2, p.y.atan2(p.x)));
+                    best = Some((d2, p));
                 }
             }
         }
-        best.map(|(_, a)| a)
+        best.map(|(_, p)| p.y.atan2(p.x))
     };
     let wrap_diff = |a: f32, b: f32| {
         let mut d = a - b;

@@ -100,7 +100,14 @@ impl Nitsch {
             Wrap::Never => false,
             Wrap::Auto => detect_wrap(points, cloud.rows, cloud.cols),
         };
-        GridView { points, rows: cloud.rows, cols: cloud.cols, wrap, max_col_gap: self.params.neighbours.max_col_gap }
+        GridView {
+            points,
+            ranges: &cloud.range_m[..n],
+            rows: cloud.rows,
+            cols: cloud.cols,
+            wrap,
+            max_col_gap: self.params.neighbours.max_col_gap,
+        }
     }
 
     /// Classifies every cell of `cloud` (all planes, grid order): true = ground. Cells without a

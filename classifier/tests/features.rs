@@ -7,7 +7,14 @@ use glam::Vec3;
 use sim::{OrderedCloud, SemanticClass};
 
 fn features(cloud: &OrderedCloud, wrap: bool, params: FeatureParams) -> Features {
-    let view = GridView { points: &cloud.point_in_vehicle, rows: cloud.rows, cols: cloud.cols, wrap, max_col_gap: 2 };
+    let view = GridView {
+        points: &cloud.point_in_vehicle,
+        ranges: &cloud.range_m,
+        rows: cloud.rows,
+        cols: cloud.cols,
+        wrap,
+        max_col_gap: 2,
+    };
     let mut f = Features::default();
     compute_features(&view, &params, &mut f);
     f
@@ -93,7 +100,14 @@ fn missing_neighbours_are_skipped_or_bridged() {
     assert_eq!(f.g_rho[at(4, 30)], 0.0);
     assert!(f.g_rho[at(4, 29)] > 0.999, "the NaN neighbour is bridged");
     // With direct neighbours only, an isolated column gap still leaves the up/down pairs.
-    let view = GridView { points: &cloud.point_in_vehicle, rows: 6, cols: 40, wrap: false, max_col_gap: 1 };
+    let view = GridView {
+        points: &cloud.point_in_vehicle,
+        ranges: &cloud.range_m,
+        rows: 6,
+        cols: 40,
+        wrap: false,
+        max_col_gap: 1,
+    };
     let nb = view.neighbours(3, 20);
     assert_eq!(nb[2], None, "right neighbour missing without gap search");
     assert_eq!(nb[0], Some(at(4, 20)));
@@ -119,7 +133,14 @@ fn wrap_is_detected_for_full_turns_only_and_joins_the_seam() {
     let fwd = SyntheticSensor::forward(8, 180, -25.0, -5.0, 120.0, 1.8).scan(&[flat_ground()]);
     assert!(!detect_wrap(&fwd.point_in_vehicle, 8, 180));
     // At the seam, with wrap, column 0 sees column 179 as its left neighbour.
-    let view = GridView { points: &spin.point_in_vehicle, rows: 8, cols: 180, wrap: true, max_col_gap: 2 };
+    let view = GridView {
+        points: &spin.point_in_vehicle,
+        ranges: &spin.range_m,
+        rows: 8,
+        cols: 180,
+        wrap: true,
+        max_col_gap: 2,
+    };
     assert_eq!(view.neighbours(3, 0)[6], Some(3 * 180 + 179));
     let fw = features(&spin, true, FeatureParams::default());
     let fnw = features(&spin, false, FeatureParams::default());

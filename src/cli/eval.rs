@@ -1,10 +1,106 @@
-//! `groundtruth eval`. TODO
+//! `groundtruth eval`: scans a scene with a rig, classifies every frame with each method and prints
+//! one row per method (`acc FPR precision recall F1 IoU`, pooled over all returns of all frames),
+//! like Table I of Nitsch et al. With `--json FILE` the same numbers are written atomically as
+//! `{"methods": {NAME: {"acc", "fpr", "precision", "recall", "f1", "iou"}}}`; `--details` also
+//! prints the per-frame means and the breakdown by class and range band.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::Context;
+use classifier::metrics::range_band_name;
+use classifier::{Evaluation, FrameInput, Scores, method_by_name};
+use sim::scan::ScanConfig;
 
 /// Arguments of `groundtruth eval`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Scene name or TOML file.
+    #[arg(long)]
+    scene: String,
+    /// Rig name or TOML file.
+    #[arg(long)]
+    rig: String,
+    /// Comma-separated method names (see `groundtruth list`).
+    #[arg(long, default_value = "nitsch,nitsch-0.7,nitsch-no-cluster,nitsch-no-cluster-0.7,ransac,grid,grid-no-cluster")]
+    methods: String,
+    /// Number of frames to scan.
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Seed of the scene, the scan noise and RANSAC.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Ego speed, metres per second.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    speed: f32,
+    /// Turn measurement effects off.
+    #[arg(long)]
+    ideal: bool,
+    /// Write the scores to this JSON file.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Also print per-frame means and the breakdown by class and range band.
+    #[arg(long)]
+    details: bool,
+}
 
 /// Runs `groundtruth eval`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`eval` is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let names = super::common::split_list(&args.methods);
+    if names.is_empty() {
+        anyhow::bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));
+    }
+    // Refuse unknown names before scanning.
+    for n in &names {
+        method_by_name(n, args.seed)?;
+    }
+    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
+    let rig = super::common::load_rig(&args.rig)?;
+    let config = ScanConfig {
+        seed: args.seed,
+        frames: args.frames,
+        speed_m_per_s: args.speed,
+        ideal: args.ideal,
+        ego_z_m: scene.ego_ground_z_m,
+        ..Default::default()
+    };
+    let frames = sim::scan::scan(&scene.mesh, &rig, &config).context("scanning")?;
+    println!("scene {} rig {} frames {} seed {}", args.scene, args.rig, frames.len(), args.seed);
+    println!("{:<24} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}", "method", "acc", "FPR", "precision", "recall", "F1", "IoU");
+    let mut json: BTreeMap<String, Scores> = BTreeMap::new();
+    for name in &names {
+        let mut method = method_by_name(name, args.seed)?;
+        let mut eval = Evaluation::default();
+        for f in &frames {
+            let input = FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };
+            let ground = method.classify(&input).with_context(|| format!("{name}: frame {}", f.index))?;
+            eval.add_frame(&f.cloud, &ground);
+        }
+        let s = eval.pooled.scores();
+        println!(
+            "{:<24} {:>7.4} {:>7.4} {:>9.4} {:>7.4} {:>7.4} {:>7.4}",
+            name, s.acc, s.fpr, s.precision, s.recall, s.f1, s.iou
+        );
+        if args.details {
+            let m = eval.per_frame_mean();
+            println!(
+                "  per-frame mean           {:>7.4} {:>7.4} {:>9.4} {:>7.4} {:>7.4} {:>7.4}",
+                m.acc, m.fpr, m.precision, m.recall, m.f1, m.iou
+            );
+            for (id, c) in &eval.by_class {
+                let called = c.tp + c.fp;
+                println!("  class {:<18} points {:>8} called ground {:>8}", Evaluation::class_name(*id), c.total(), called);
+            }
+            for (b, c) in eval.by_range.iter().enumerate() {
+                let s = c.scores();
+                println!("  range {:<10} points {:>8} acc {:.4} FPR {:.4} F1 {:.4}", range_band_name(b), c.total(), s.acc, s.fpr, s.f1);
+            }
+        }
+        json.insert(name.clone(), s);
+    }
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&serde_json::json!({ "methods": json }))?;
+        sim::io::atomic::write_bytes_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
 }
