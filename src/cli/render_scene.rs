@@ -29,9 +29,11 @@ const BACKGROUND: Rgb<u8> = Rgb([24, 24, 24]);
 /// Draws the picture.
 pub fn run(args: &super::render::Args) -> anyhow::Result<()> {
     let name = args.scene.as_deref().context("render needs --scene")?;
-    let scene = scenes::load(name, args.seed)?;
+    // Bundled scenes, TOML files and the simulator's built-ins, resolved as `scan` resolves them.
+    let scene = super::common::load_scene_full(name, args.seed)?;
     let cut_z = covered_from_above(&scene.mesh, scene.ego_ground_z_m).then_some(scene.ego_ground_z_m + CUT_ABOVE_EGO_M);
-    let mut title = vec![scene.name.clone(), format!("seed {}", scene.seed)];
+    let short_name = std::path::Path::new(name).file_stem().map_or(name.into(), |s| s.to_string_lossy().into_owned());
+    let mut title = vec![short_name, format!("seed {}", args.seed)];
     if cut_z.is_some() {
         title.push(format!("cut at {CUT_ABOVE_EGO_M} m"));
     }
@@ -215,5 +217,55 @@ fn fill_rect(img: &mut RgbImage, x: i32, y: i32, w: i32, h: i32, color: Rgb<u8>)
 fn put(img: &mut RgbImage, x: i32, y: i32, color: Rgb<u8>) {
     if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
         img.put_pixel(x as u32, y as u32, color);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sim::Surface;
+
+    fn scene() -> SceneMesh {
+        let mut m = SceneMesh::new();
+        m.push_heightfield((-50.0, -50.0), 10.0, (10, 10), |_, _| 0.0, |_, _| Surface::stuff(SemanticClass::ROAD));
+        m.push_box(Vec3::new(20.0, -5.0, 0.0), Vec3::new(30.0, 5.0, 1.5), Surface::object(SemanticClass::CAR, 1));
+        m
+    }
+
+    /// The shaded colour of a horizontal surface of `class`.
+    fn flat_color(class: SemanticClass) -> [u8; 3] {
+        let shade = 0.55 + 0.45 * Vec3::new(0.4, 0.3, 1.0).normalize().z;
+        class.color().map(|v| (f32::from(v) * shade).min(255.0) as u8)
+    }
+
+    #[test]
+    fn top_view_puts_classes_where_they_are() {
+        let img = draw(&scene(), &["t".into()], None).unwrap();
+        // 100 m over 1200 px; x forward is up: x = 25 m lies 25 m above the centre row.
+        let px_per_m = MAP_PX as f32 / 100.0;
+        assert_eq!(img.width(), MAP_PX + 1 + LEGEND_PX);
+        let (cx, cy) = (600.0, 600.0);
+        let car = img.get_pixel(cx as u32, (cy - 25.0 * px_per_m) as u32);
+        assert_eq!(car.0, flat_color(SemanticClass::CAR));
+        let road = img.get_pixel((cx + 30.0 * px_per_m) as u32, (cy + 30.0 * px_per_m) as u32);
+        assert_eq!(road.0, flat_color(SemanticClass::ROAD));
+        // The ego arrow at the origin.
+        assert_eq!(img.get_pixel(cx as u32, cy as u32).0, WHITE.0);
+    }
+
+    #[test]
+    fn a_ceiling_over_the_ego_switches_to_a_floor_plan() {
+        let mut m = scene();
+        assert!(!covered_from_above(&m, 0.0));
+        m.push_box(
+            Vec3::new(-10.0, -10.0, 2.7),
+            Vec3::new(10.0, 10.0, 3.0),
+            Surface::object(SemanticClass::OTHER_STRUCTURE, 2),
+        );
+        assert!(covered_from_above(&m, 0.0));
+        let img = draw(&m, &["t".into()], Some(2.5)).unwrap();
+        let px_per_m = MAP_PX as f32 / 100.0;
+        // Under the cut-away ceiling the road shows again.
+        assert_eq!(img.get_pixel((600.0 + 5.0 * px_per_m) as u32, 600).0, flat_color(SemanticClass::ROAD));
     }
 }
