@@ -5,8 +5,8 @@
 //! - **Rows**: every (sensor, ring) pair is one merged row; rows are sorted by the ring's elevation
 //!   in the vehicle frame (the elevation of its middle fired beam after the mount rotation), lowest
 //!   first. A 4-LUX roof rig thus gives 16 rows with the layers of the four sensors interleaved.
-//! - **Columns**: each sensor column has a vehicle-frame azimuth (its nominal horizontal direction
-//!   rotated by the mount). Columns are sorted by azimuth, decreasing (clockwise), starting at sensor
+//! - **Columns**: each sensor column has a vehicle-frame azimuth: the mount's yaw plus the column's
+//!   nominal azimuth (mount pitch and roll are ignored here, so equally yawed sensors share columns). Columns are sorted by azimuth, decreasing (clockwise), starting at sensor
 //!   0's column 0. Columns of different sensors whose azimuths agree within half the finer of their
 //!   steps share a merged column (identical forward LUX share all columns); otherwise each gets its
 //!   own merged column.
@@ -63,12 +63,10 @@ impl RigLayout {
         }
 
         // Columns: vehicle-frame azimuth, measured clockwise from sensor 0's column 0.
-        let azimuth = |s: usize, c: usize| {
-            let p = &patterns[s];
-            let a = p.col_azimuth_rad[c];
-            let d = rig.sensors[s].mount.vehicle_from_sensor().matrix3 * Vec3::new(a.cos(), a.sin(), 0.0);
-            d.y.atan2(d.x)
-        };
+        // A column's vehicle azimuth is the mount's yaw plus the column's nominal azimuth: pitch and
+        // roll of the mount skew the flanks slightly (0.45 deg at 50 deg azimuth for 10 deg of pitch),
+        // but the same columns of equally yawed sensors stay one merged column.
+        let azimuth = |s: usize, c: usize| rig.sensors[s].mount.yaw_deg.to_radians() + patterns[s].col_azimuth_rad[c];
         let step = |s: usize| {
             let p = &patterns[s];
             if p.cols < 2 {

@@ -207,40 +207,31 @@ impl<'a> Scanner<'a> {
         Frame { index, start_time_s, vehicle_pose, world_from_vehicle: vehicle_pose.world_from_vehicle(), cloud }
     }
 
-    /// Scans one merged row into its plane-0 cells; returns second and later echoes.
-    fn scan_row(&self, frame: usize, start_time_s: f64, row: usize, view: &mut RowView<'_>) -> Vec<ExtraEcho> {
+    /// The world rays of merged row `row` in frame `frame`, each from the vehicle pose at its shot's
+    /// own time, in column order (coherent for the caster). With multi-echo sensors each beam is
+    /// followed by two sub-beams at the horizontal edges of its divergence cone.
+    pub fn row_rays(&self, frame: usize, row: usize) -> RowRays {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
         let vehicle_from_sensor = self.vehicle_from_sensor[s];
+        let start_time_s = frame as f64 * self.frame_period_s;
         let static_world_from_sensor = self.track.frame_start(frame).world_from_vehicle() * vehicle_from_sensor;
         let t_max = cast_limit_m(m);
         let sub_rays = if m.max_echoes > 1 && m.beam_divergence_rad > 0.0 { 3 } else { 1 };
-
-        for v in view.ring.iter_mut() {
-            *v = ring as u16;
-        }
-        // Gather the row's beams and their world rays, in column order (coherent for the caster).
-        let mut beams: Vec<(usize, Firing, Affine3A)> = Vec::with_capacity(pattern.cols);
-        let mut rays: Vec<Ray> = Vec::with_capacity(pattern.cols * sub_rays);
+        let mut beams = Vec::with_capacity(pattern.cols);
+        let mut rays = Vec::with_capacity(pattern.cols * sub_rays);
         for c in 0..pattern.cols {
-            let mc = self.layout.col_of[s][c];
-            view.sensor[mc] = s as u8;
-            view.column[mc] = c as u32;
-            view.time[mc] = start_time_s;
             let Some(f) = pattern.at(ring, c) else { continue };
-            let time_s = start_time_s + f.time_s;
-            view.time[mc] = time_s;
             let world_from_sensor = if self.track.is_static() {
                 static_world_from_sensor
             } else {
-                self.track.at(time_s).world_from_vehicle() * vehicle_from_sensor
+                self.track.at(start_time_s + f.time_s).world_from_vehicle() * vehicle_from_sensor
             };
             let origin = world_from_sensor.transform_point3(f.origin_in_sensor);
             let dir = world_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
             rays.push(Ray { origin, dir, t_max });
             if sub_rays > 1 {
-                // Sub-beams at the horizontal edges of the divergence cone (edge straddling -> echoes).
                 let side = world_from_sensor.transform_vector3(f.dir_in_sensor.cross(Vec3::Z)).normalize_or_zero();
                 let off = (0.5 * m.beam_divergence_rad).tan();
                 for sign in [-1.0f32, 1.0] {
@@ -249,6 +240,31 @@ impl<'a> Scanner<'a> {
             }
             beams.push((c, *f, world_from_sensor));
         }
+        RowRays { beams, rays, sub_rays }
+    }
+
+    /// Number of merged rows of every frame.
+    pub fn rows(&self) -> usize {
+        self.layout.rows
+    }
+
+    /// Scans one merged row into its plane-0 cells; returns second and later echoes.
+    fn scan_row(&self, frame: usize, start_time_s: f64, row: usize, view: &mut RowView<'_>) -> Vec<ExtraEcho> {
+        let (s, ring) = self.row_source[row];
+        let pattern = &self.patterns[s];
+        let m = &self.measurements[s];
+        let vehicle_from_sensor = self.vehicle_from_sensor[s];
+
+        for v in view.ring.iter_mut() {
+            *v = ring as u16;
+        }
+        for c in 0..pattern.cols {
+            let mc = self.layout.col_of[s][c];
+            view.sensor[mc] = s as u8;
+            view.column[mc] = c as u32;
+            view.time[mc] = start_time_s + pattern.at(ring, c).map_or(0.0, |f| f.time_s);
+        }
+        let RowRays { beams, rays, sub_rays } = self.row_rays(frame, row);
         let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
         self.caster.cast_batch(&rays, &mut hits);
 
@@ -329,6 +345,16 @@ fn merge_echoes(echoes: &mut Vec<(f32, Hit, u32)>, separation_m: f32) {
         }
     }
     *echoes = out;
+}
+
+/// The rays of one merged row (see [`Scanner::row_rays`]).
+pub struct RowRays {
+    /// `(sensor column, firing, world_from_sensor at the shot time)` per fired beam.
+    pub beams: Vec<(usize, Firing, Affine3A)>,
+    /// `sub_rays` rays per beam, the beam's own ray first.
+    pub rays: Vec<Ray>,
+    /// Rays per beam (3 with multi-echo divergence sampling, else 1).
+    pub sub_rays: usize,
 }
 
 /// A return's fields, for writing a cell of a later echo plane.

@@ -46,28 +46,6 @@ pub struct Args {
     pub backend: String,
 }
 
-/// Parses a comma-separated format list.
-pub fn parse_formats(list: &str) -> anyhow::Result<Formats> {
-    let mut f = Formats::default();
-    for item in super::common::split_list(list) {
-        match item.as_str() {
-            "pcd" => f.pcd = true,
-            "pcd-ascii" => {
-                f.pcd = true;
-                f.pcd_ascii = true;
-            }
-            "ply" => f.ply = true,
-            "kitti" => f.kitti = true,
-            "las" => f.las = true,
-            other => anyhow::bail!("unknown --format `{other}`; allowed: pcd, pcd-ascii, ply, kitti, las"),
-        }
-    }
-    if f == Formats::default() {
-        anyhow::bail!("--format is empty; allowed: pcd, pcd-ascii, ply, kitti, las");
-    }
-    Ok(f)
-}
-
 /// Parses a backend name.
 pub fn parse_backend(name: &str) -> anyhow::Result<Backend> {
     match name {
@@ -108,7 +86,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Scans as `args` says, writes every frame's files and the manifest into `args.out`, and returns the manifest.
 pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
-    let formats = parse_formats(&args.format)?;
+    let formats = Formats::parse(&args.format)?;
     let backend = parse_backend(&args.backend)?;
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;

@@ -18,7 +18,7 @@
 //! destaggered and origin offsets turn with the head (see [`super::spinning`]).
 //!
 //! Measurement defaults: 0.5 .. 100 m, sigma 0.02 m, no quantisation, grazing dropout beyond
-//! 85 deg, divergence 3 mrad, one echo, echo separation 1 m, intensity reference 10 m.
+//! 89 deg, divergence 3 mrad, one echo, echo separation 1 m, intensity reference 10 m.
 
 use serde::{Deserialize, Serialize};
 
@@ -161,7 +161,7 @@ impl CustomSpec {
             max_range_m: 100.0,
             range_sigma_m: 0.02,
             range_quantum_m: 0.0,
-            max_incidence_deg: 85.0,
+            max_incidence_deg: 89.0,
             beam_divergence_rad: 0.003,
             max_echoes: 1,
             echo_separation_m: 1.0,

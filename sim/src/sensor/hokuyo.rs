@@ -61,7 +61,7 @@ pub fn utm_beams(fov_deg: f32) -> Vec<UtmBeam> {
 }
 
 /// The UTM-30LX measurement defaults: 0.1 .. 30 m, sigma 0.01 m (the < 10 m figure, used at all
-/// ranges), 1 mm quantum (ranges are reported in mm), grazing dropout beyond 85 deg, divergence
+/// ranges), 1 mm quantum (ranges are reported in mm), grazing dropout beyond 89 deg, divergence
 /// 0 (unverified: a thin beam), one echo (the -EW variant: `measurement.max_echoes = 3`), echo
 /// separation 1 m, intensity reference 5 m.
 pub fn utm_measurement(params: &MeasurementParams) -> Measurement {
@@ -70,7 +70,7 @@ pub fn utm_measurement(params: &MeasurementParams) -> Measurement {
         max_range_m: 30.0,
         range_sigma_m: 0.01,
         range_quantum_m: 0.001,
-        max_incidence_deg: 85.0,
+        max_incidence_deg: 89.0,
         beam_divergence_rad: 0.0,
         max_echoes: 1,
         echo_separation_m: 1.0,

@@ -55,7 +55,7 @@ pub struct LuxSector {
 ///
 /// Measurement defaults: 0.3 .. 200 m, sigma 0.04 m (the spec's 10 cm accuracy read as 2.5
 /// sigma), 0.01 m quantum (distances are sent in whole centimetres), grazing dropout beyond
-/// 85 deg, divergence 0.08 deg (the horizontal beam width; the 0.8 deg vertical height is the
+/// 89 deg, divergence 0.08 deg (the horizontal beam width; the 0.8 deg vertical height is the
 /// layer spacing), up to 3 echoes, echo separation 1 m (unverified), intensity reference 20 m.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -321,7 +321,7 @@ impl LuxSpec {
             max_range_m: 200.0,
             range_sigma_m: 0.04,
             range_quantum_m: 0.01,
-            max_incidence_deg: 85.0,
+            max_incidence_deg: 89.0,
             beam_divergence_rad: 0.08_f32.to_radians(),
             max_echoes: 3,
             echo_separation_m: 1.0,

@@ -50,7 +50,7 @@ fn validate_mode(field: &str, columns: u32, frequency_hz: f32) -> Result<()> {
 }
 
 /// The measurement defaults of both OS1 models: 0.5 .. 120 m, sigma 0.01 m, 1 mm quantum, grazing
-/// dropout beyond 85 deg, divergence 3 mrad (0.18 deg), one echo, echo separation 1 m, intensity
+/// dropout beyond 89 deg, divergence 3 mrad (0.18 deg), one echo, echo separation 1 m, intensity
 /// reference 10 m.
 fn os1_measurement(params: &MeasurementParams) -> Measurement {
     params.apply(Measurement {
@@ -58,7 +58,7 @@ fn os1_measurement(params: &MeasurementParams) -> Measurement {
         max_range_m: 120.0,
         range_sigma_m: 0.01,
         range_quantum_m: 0.001,
-        max_incidence_deg: 85.0,
+        max_incidence_deg: 89.0,
         beam_divergence_rad: 0.003,
         max_echoes: 1,
         echo_separation_m: 1.0,

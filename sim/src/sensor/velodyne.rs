@@ -24,7 +24,7 @@ pub const VLP16_CYCLE_S: f64 = 55.296e-6;
 /// 16 firings of one cycle span 0.13 deg at 10 Hz and all fall in one column.
 ///
 /// Measurement defaults: 0.5 .. 100 m, sigma 0.03 m, 2 mm quantum (the packet's distance unit),
-/// grazing dropout beyond 85 deg, divergence 3 mrad, one echo (the dual-return mode: set
+/// grazing dropout beyond 89 deg, divergence 3 mrad, one echo (the dual-return mode: set
 /// `measurement.max_echoes = 2`), echo separation 1 m, intensity reference 10 m.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -79,7 +79,7 @@ impl Vlp16Spec {
             max_range_m: 100.0,
             range_sigma_m: 0.03,
             range_quantum_m: 0.002,
-            max_incidence_deg: 85.0,
+            max_incidence_deg: 89.0,
             beam_divergence_rad: 0.003,
             max_echoes: 1,
             echo_separation_m: 1.0,
@@ -118,7 +118,7 @@ const HDL64E_AZIMUTH_PATTERN_DEG: [[f64; 4]; 2] = [[-8.5, -3.1, 2.9, 8.2], [-7.6
 /// 15 Hz. The grid is destaggered (see [`super::spinning`]).
 ///
 /// Measurement defaults: 0.9 .. 120 m (the 80 % reflectivity range), sigma 0.02 m, 2 mm quantum,
-/// grazing dropout beyond 85 deg, divergence 2 mrad, one echo, echo separation 1 m, intensity
+/// grazing dropout beyond 89 deg, divergence 2 mrad, one echo, echo separation 1 m, intensity
 /// reference 12 m.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -184,7 +184,7 @@ impl Hdl64eSpec {
             max_range_m: 120.0,
             range_sigma_m: 0.02,
             range_quantum_m: 0.002,
-            max_incidence_deg: 85.0,
+            max_incidence_deg: 89.0,
             beam_divergence_rad: 0.002,
             max_echoes: 1,
             echo_separation_m: 1.0,
