@@ -3,10 +3,11 @@
 //! ray/triangle test ([`watertight`]), so a ray along a shared edge never slips through.
 
 mod bvh;
+pub mod fixture;
 mod reference;
 pub mod watertight;
 
-pub use bvh::BvhCaster;
+pub use bvh::{BvhCaster, BvhLayout, BvhOptions};
 pub use reference::ParryCaster;
 
 use glam::Vec3;

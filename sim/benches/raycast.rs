@@ -1,0 +1,34 @@
+//! Ray casting speed on the 1.3 M-triangle fixture terrain with one 128 x 2048 spinning-LiDAR frame
+//! (262,144 rays): the BVH backend (binary and wide layouts, with and without the coherence seed,
+//! on 1 and 2 threads) and the parry reference. `cargo bench -p sim --bench raycast`.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use sim::cast::{BvhCaster, BvhLayout, BvhOptions, Caster, ParryCaster, fixture};
+
+fn raycast(c: &mut Criterion) {
+    let mesh = fixture::terrain_scene();
+    let rays = fixture::lidar_rays(1);
+    let mut g = c.benchmark_group("raycast_fixture_frame");
+    g.throughput(Throughput::Elements(rays.len() as u64));
+    g.sample_size(10);
+    let variants = [
+        ("bvh", BvhOptions::default()),
+        ("bvh-no-coherence", BvhOptions { coherent: false, ..BvhOptions::default() }),
+        ("cwbvh", BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() }),
+    ];
+    for (name, options) in variants {
+        let caster = BvhCaster::with_options(&mesh, options);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+            g.bench_function(format!("{name}/{threads}t"), |b| b.iter(|| pool.install(|| caster.cast_all(&rays))));
+        }
+    }
+    let parry = ParryCaster::new(&mesh);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("thread pool");
+    g.bench_function("parry/2t", |b| b.iter(|| pool.install(|| parry.cast_all(&rays))));
+    g.finish();
+    c.bench_function("bvh_build_fixture", |b| b.iter(|| BvhCaster::new(&mesh)));
+}
+
+criterion_group!(benches, raycast);
+criterion_main!(benches);

@@ -1,0 +1,258 @@
+//! Caster tests: the production BVH backend against the parry reference on a random scene,
+//! watertightness on grid edges and vertices, analytic plane distances, and thread-count
+//! independence of `cast_all`.
+
+use glam::{Affine3A, Quat, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use sim::cast::watertight::intersect_triangle;
+use sim::cast::{BvhCaster, BvhLayout, BvhOptions, Caster, Hit, ParryCaster, Ray, fixture};
+use sim::{SceneMesh, SemanticClass, Surface};
+
+/// Random scene: a bumpy 64 x 64-cell heightfield and 40 random (rotated) boxes.
+fn random_scene(seed: u64) -> SceneMesh {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut m = SceneMesh::new();
+    let bumps: Vec<(f32, f32, f32)> = (0..12)
+        .map(|_| (rng.random_range(-30.0..30.0), rng.random_range(-30.0..30.0), rng.random_range(-2.0..3.0)))
+        .collect();
+    m.push_heightfield(
+        (-32.0, -32.0),
+        1.0,
+        (64, 64),
+        |x, y| bumps.iter().map(|&(bx, by, h)| h * (-((x - bx).powi(2) + (y - by).powi(2)) / 40.0).exp()).sum(),
+        |_, _| Surface::stuff(SemanticClass::TERRAIN),
+    );
+    for i in 0..40 {
+        let c = Vec3::new(rng.random_range(-28.0..28.0), rng.random_range(-28.0..28.0), rng.random_range(-1.0..2.0));
+        let half = Vec3::new(rng.random_range(0.3..4.0), rng.random_range(0.3..4.0), rng.random_range(0.3..3.0));
+        let rot =
+            Quat::from_rotation_z(rng.random_range(0.0..6.3)) * Quat::from_rotation_x(rng.random_range(-0.3..0.3));
+        m.push_oriented_box(
+            Affine3A::from_rotation_translation(rot, c),
+            -half,
+            half,
+            Surface::object(SemanticClass::CAR, i + 1),
+        );
+    }
+    m
+}
+
+fn random_rays(seed: u64, n: usize) -> Vec<Ray> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            let origin =
+                Vec3::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0), rng.random_range(-1.0..12.0));
+            let dir = loop {
+                let d =
+                    Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..0.6));
+                if d.length() > 0.1 && d.length() <= 1.0 {
+                    break d.normalize();
+                }
+            };
+            let t_max = if rng.random_range(0.0..1.0) < 0.2 { rng.random_range(1.0..30.0) } else { f32::INFINITY };
+            Ray { origin, dir, t_max }
+        })
+        .collect()
+}
+
+fn compare(mesh: &SceneMesh, rays: &[Ray], a: &[Option<Hit>], b: &[Option<Hit>]) -> (usize, usize) {
+    let mut hits = 0;
+    let mut ties = 0;
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        match (x, y) {
+            (None, None) => {}
+            (Some(x), Some(y)) => {
+                hits += 1;
+                assert!((x.t - y.t).abs() <= 1e-4, "ray {i}: t {} vs {}", x.t, y.t);
+                if x.triangle != y.triangle {
+                    // Only a genuine tie may pick another triangle: both triangles at the same distance.
+                    let tx = intersect_triangle(&rays[i], mesh.triangle(x.triangle as usize)).unwrap();
+                    let ty = intersect_triangle(&rays[i], mesh.triangle(y.triangle as usize)).unwrap();
+                    assert!((tx - ty).abs() <= 1e-4, "ray {i}: triangles {} and {} not tied", x.triangle, y.triangle);
+                    ties += 1;
+                }
+            }
+            _ => panic!("ray {i} {:?}: hit/miss differ: {x:?} vs {y:?}", rays[i]),
+        }
+    }
+    (hits, ties)
+}
+
+#[test]
+fn bvh_matches_parry_on_random_scene() {
+    let mesh = random_scene(7);
+    let rays = random_rays(11, 100_000);
+    let reference = ParryCaster::new(&mesh);
+    let expected: Vec<Option<Hit>> = rays.iter().map(|r| reference.cast(r)).collect();
+    for options in [
+        BvhOptions::default(),
+        BvhOptions { coherent: false, ..BvhOptions::default() },
+        BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() },
+    ] {
+        let bvh = BvhCaster::with_options(&mesh, options);
+        let got = bvh.cast_all(&rays);
+        let (hits, ties) = compare(&mesh, &rays, &got, &expected);
+        assert!(hits > 20_000 && hits < 90_000, "{options:?}: {hits} hits is not a mixed hit/miss set");
+        assert!(ties < 100, "{options:?}: {ties} ties");
+    }
+}
+
+/// A regular grid of 1 m cells on the plane `z = slope_x * x + slope_y * y` (vertices exactly
+/// representable for slopes that are short binary fractions).
+fn plane_grid(n: usize, slope_x: f32, slope_y: f32) -> SceneMesh {
+    let mut m = SceneMesh::new();
+    let half = n as f32 / 2.0;
+    m.push_heightfield(
+        (-half, -half),
+        1.0,
+        (n, n),
+        |x, y| slope_x * x + slope_y * y,
+        |_, _| Surface::stuff(SemanticClass::ROAD),
+    );
+    m
+}
+
+/// Rays exactly through grid vertices, edge midpoints (axis-aligned and diagonal edges), and along
+/// grid lines (direction inside the vertical plane of a line of edges), from many origins.
+fn edge_rays(n: usize, slope_x: f32, slope_y: f32, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let lim = n as i32 / 2 - 2;
+    let mut rays = Vec::with_capacity(count);
+    while rays.len() < count {
+        let (i, j) = (rng.random_range(-lim..lim) as f32, rng.random_range(-lim..lim) as f32);
+        let (tx, ty) = match rng.random_range(0..4) {
+            0 => (i, j),
+            1 => (i + 0.5, j),
+            2 => (i, j + 0.5),
+            _ => (i + 0.5, j + 0.5),
+        };
+        let target = Vec3::new(tx, ty, slope_x * tx + slope_y * ty);
+        let h = rng.random_range(0.3..25.0);
+        let origin = match rng.random_range(0..4) {
+            // Along the grid line y = ty (azimuth exactly 0 or 180 deg).
+            0 => Vec3::new(tx + rng.random_range(-30.0..30.0), ty, target.z + h),
+            // Along the grid line x = tx.
+            1 => Vec3::new(tx, ty + rng.random_range(-30.0..30.0), target.z + h),
+            // Along a diagonal line x - y = const (the shared diagonals of the cells).
+            2 => {
+                let s = rng.random_range(-20.0..20.0f32).round();
+                Vec3::new(tx + s, ty + s, target.z + h)
+            }
+            _ => Vec3::new(tx + rng.random_range(-30.0..30.0), ty + rng.random_range(-30.0..30.0), target.z + h),
+        };
+        let d = target - origin;
+        // Skip rays nearly parallel to the plane (incidence beyond ~84 deg): there the distance is
+        // ill-conditioned in f32 (and a LiDAR drops such grazing returns anyway).
+        let normal = Vec3::new(-slope_x, -slope_y, 1.0).normalize();
+        if d.length() < 1e-3 || d.normalize().dot(normal).abs() < 0.1 {
+            continue;
+        }
+        rays.push(Ray { origin, dir: d.normalize(), t_max: f32::INFINITY });
+    }
+    rays
+}
+
+/// Distance along `ray` to the plane `z = sx x + sy y`.
+fn plane_t(ray: &Ray, sx: f32, sy: f32) -> f64 {
+    let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+    let (sx, sy) = (sx as f64, sy as f64);
+    -(o.z - sx * o.x - sy * o.y) / (d.z - sx * d.x - sy * d.y)
+}
+
+fn cos_incidence(ray: &Ray, sx: f32, sy: f32) -> f64 {
+    ray.dir.as_dvec3().dot(glam::DVec3::new(-sx as f64, -sy as f64, 1.0).normalize()).abs()
+}
+
+fn assert_no_leaks(caster: &dyn Caster, rays: &[Ray], sx: f32, sy: f32, name: &str) {
+    let hits = caster.cast_all(rays);
+    let mut leaks = 0;
+    for (r, h) in rays.iter().zip(&hits) {
+        let expected = plane_t(r, sx, sy);
+        match h {
+            // f32 distance error grows as 1 / cos(incidence) (at most 10x here); a leak is metres off.
+            Some(h) if (h.t as f64 - expected).abs() <= 1e-4 * expected.max(1.0) / cos_incidence(r, sx, sy) => {}
+            _ => {
+                leaks += 1;
+                eprintln!("{name}: leak {r:?}: {h:?}, expected t = {expected}");
+            }
+        }
+    }
+    assert_eq!(leaks, 0, "{name}: {leaks} of {} rays leaked", rays.len());
+}
+
+#[test]
+fn grid_edges_and_vertices_never_leak() {
+    for (sx, sy) in [(0.0, 0.0), (0.25, -0.125)] {
+        let mesh = plane_grid(96, sx, sy);
+        let rays = edge_rays(96, sx, sy, 150_000, 5);
+        assert_no_leaks(&BvhCaster::new(&mesh), &rays, sx, sy, "bvh");
+        let wide = BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() };
+        assert_no_leaks(&BvhCaster::with_options(&mesh, wide), &rays, sx, sy, "bvh-wide");
+        assert_no_leaks(&ParryCaster::new(&mesh), &rays[..50_000], sx, sy, "parry");
+    }
+}
+
+#[test]
+fn ideal_rays_hit_the_analytic_point_on_a_plane() {
+    let (sx, sy) = (0.1, 0.05);
+    let mesh = plane_grid(64, sx, sy);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+    let rays: Vec<Ray> = (0..20_000)
+        .map(|_| {
+            let target = Vec3::new(rng.random_range(-30.0..30.0), rng.random_range(-30.0..30.0), 0.0);
+            let target = Vec3::new(target.x, target.y, sx * target.x + sy * target.y);
+            let origin = Vec3::new(rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), 6.0);
+            Ray { origin, dir: (target - origin).normalize(), t_max: 200.0 }
+        })
+        .collect();
+    for caster in [&BvhCaster::new(&mesh) as &dyn Caster, &ParryCaster::new(&mesh)] {
+        for (r, h) in rays.iter().zip(caster.cast_all(&rays)) {
+            let h = h.expect("ray hits the plane");
+            let p = (r.origin + h.t * r.dir).as_dvec3();
+            let on_plane = sx as f64 * p.x + sy as f64 * p.y;
+            assert!((p.z - on_plane).abs() < 1e-4, "hit {p} off the plane by {}", p.z - on_plane);
+            assert!((h.t as f64 - plane_t(r, sx, sy)).abs() < 1e-4);
+        }
+    }
+    // Beyond t_max: no hit.
+    let far = Ray { origin: Vec3::new(0.0, 0.0, 6.0), dir: Vec3::new(1.0, 0.0, -0.1).normalize(), t_max: 10.0 };
+    assert_eq!(BvhCaster::new(&mesh).cast(&far), None);
+    assert_eq!(ParryCaster::new(&mesh).cast(&far), None);
+}
+
+#[test]
+fn cast_all_is_identical_on_one_and_two_threads() {
+    let mesh = random_scene(21);
+    // A spinning-LiDAR pattern (coherent rays, where cast_batch reuses the previous hit).
+    let origin = Vec3::new(0.5, 0.25, 3.0);
+    let mut rays: Vec<Ray> = (0..32)
+        .flat_map(|r| (0..512).map(move |c| (r, c)))
+        .map(|(r, c)| {
+            let d = fixture::beam_dir(r * 4, c * 4);
+            Ray { origin, dir: d, t_max: 80.0 }
+        })
+        .collect();
+    rays.extend(random_rays(4, 10_000));
+    let caster = BvhCaster::new(&mesh);
+    let run = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| caster.cast_all(&rays));
+    let one = run(1);
+    let two = run(2);
+    assert_eq!(one, two);
+    let hits = one.iter().filter(|h| h.is_some()).count();
+    assert!(hits > 10_000, "{hits} hits");
+    // And the batched (coherent) results equal the one-ray-at-a-time results.
+    let single: Vec<Option<Hit>> = rays.iter().map(|r| caster.cast(r)).collect();
+    let (_, ties) = compare(&mesh, &rays, &one, &single);
+    assert!(ties < 50, "{ties} ties");
+}
+
+#[test]
+fn empty_scene_never_hits() {
+    let mesh = SceneMesh::new();
+    let r = Ray { origin: Vec3::ZERO, dir: Vec3::X, t_max: f32::INFINITY };
+    assert_eq!(BvhCaster::new(&mesh).cast(&r), None);
+    assert_eq!(ParryCaster::new(&mesh).cast(&r), None);
+    assert_eq!(BvhCaster::new(&mesh).cast_all(&[r; 3]), vec![None; 3]);
+}

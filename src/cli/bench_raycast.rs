@@ -1,0 +1,229 @@
+//! `groundtruth bench raycast`: ray casting speed of a caster backend on a scene or mesh, with the
+//! rays of a rig or of a raw ray file. Prints one JSON object.
+//!
+//! Sources of geometry: `--scene NAME` (the scene library through `common::load_scene_full`, or
+//! `fixture-terrain`, the 1.3 M-triangle benchmark terrain of `sim::cast::fixture`) or
+//! `--mesh FILE.ply` (binary or ASCII PLY, read by `sim::scene::ply::read_mesh`).
+//! Sources of rays: `--rig NAME` (every sensor's firing pattern placed by its mount, range limited to
+//! the sensor's maximum range, the vehicle on the scene's ground at the origin, moving 1 m along +x per
+//! frame), `--rig fixture-128x2048` (the fixture LiDAR, unlimited range) or `--rays FILE` (raw
+//! little-endian `f32` records `ox oy oz dx dy dz`, 24 bytes each, cast with unlimited range or
+//! `--max-range-m`; the same rays are cast once per frame).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use glam::Vec3;
+use sim::cast::{Backend, Ray, fixture};
+
+/// Scene name of the benchmark fixture terrain.
+const FIXTURE_SCENE: &str = "fixture-terrain";
+/// Rig name of the benchmark fixture LiDAR.
+const FIXTURE_RIG: &str = "fixture-128x2048";
+/// Bytes per record of a ray file.
+const RAY_RECORD_BYTES: usize = 24;
+/// Largest accepted frame count.
+const MAX_FRAMES: usize = 10_000;
+/// Largest accepted ray count (all frames together).
+const MAX_RAYS: usize = 1 << 31;
+
+/// Arguments of `groundtruth bench raycast`.
+#[derive(clap::Args, Debug)]
+#[command(group(clap::ArgGroup::new("geometry").required(true).args(["scene", "mesh"])))]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["rig", "rays"])))]
+pub struct Args {
+    /// Scene name or TOML file (or `fixture-terrain`, the 1.3 M-triangle benchmark terrain).
+    #[arg(long)]
+    scene: Option<String>,
+    /// A PLY triangle mesh to cast against.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// Rig name or TOML file (or `fixture-128x2048`, the benchmark LiDAR).
+    #[arg(long)]
+    rig: Option<String>,
+    /// Raw ray file: little-endian f32 records `ox oy oz dx dy dz` (24 bytes per ray).
+    #[arg(long)]
+    rays: Option<PathBuf>,
+    /// Frames to cast (1..=10000).
+    #[arg(long, default_value_t = 4)]
+    frames: usize,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Caster backend.
+    #[arg(long, value_enum, default_value_t = BackendArg::Bvh)]
+    backend: BackendArg,
+    /// Seed of a procedural scene.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Range limit for `--rays` files, metres (default: unlimited).
+    #[arg(long)]
+    max_range_m: Option<f32>,
+}
+
+/// The `--backend` values.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum BackendArg {
+    /// obvhs BVH (production).
+    Bvh,
+    /// parry3d BVH (reference).
+    Parry,
+}
+
+/// Runs the benchmark and prints one JSON object.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    if a.frames == 0 || a.frames > MAX_FRAMES {
+        bail!("invalid value for `--frames`: {} (allowed: 1 ..= {MAX_FRAMES})", a.frames);
+    }
+    if let Some(r) = a.max_range_m
+        && !(r.is_finite() && r > 0.0)
+    {
+        bail!("invalid value for `--max-range-m`: {r} (allowed: finite, > 0)");
+    }
+    let (mesh, ego_ground_z_m, geometry) = match (&a.scene, &a.mesh) {
+        (Some(s), _) if s == FIXTURE_SCENE => (fixture::terrain_scene(), 0.0, s.clone()),
+        (Some(s), _) => {
+            let l = crate::cli::common::load_scene_full(s, a.seed)?;
+            (l.mesh, l.ego_ground_z_m, s.clone())
+        }
+        (None, Some(p)) => (sim::scene::ply::read_mesh(p)?, 0.0, p.display().to_string()),
+        (None, None) => bail!("give --scene NAME or --mesh FILE.ply"),
+    };
+    let rays = match (&a.rig, &a.rays) {
+        (Some(r), _) if r == FIXTURE_RIG => fixture::lidar_rays(a.frames),
+        (Some(r), _) => rig_rays(r, a.frames, ego_ground_z_m)?,
+        (None, Some(p)) => {
+            let one = read_ray_file(p, a.max_range_m.unwrap_or(f32::INFINITY))?;
+            if one.len().saturating_mul(a.frames) > MAX_RAYS {
+                bail!("{}: {} rays x {} frames is more than {MAX_RAYS} rays", p.display(), one.len(), a.frames);
+            }
+            one.iter().cycle().take(one.len() * a.frames).copied().collect()
+        }
+        (None, None) => bail!("give --rig NAME or --rays FILE"),
+    };
+    let backend = match a.backend {
+        BackendArg::Bvh => Backend::Bvh,
+        BackendArg::Parry => Backend::Parry,
+    };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads).build().context("starting the thread pool")?;
+    let threads = pool.current_num_threads();
+    let t0 = Instant::now();
+    let caster = pool.install(|| backend.build(&mesh));
+    let build_s = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let hits = pool.install(|| caster.cast_all(&rays));
+    let cast_s = t1.elapsed().as_secs_f64();
+    let hit_count = hits.iter().filter(|h| h.is_some()).count();
+    let json = serde_json::json!({
+        "backend": backend.name(),
+        "geometry": geometry,
+        "source": a.rig.clone().unwrap_or_else(|| a.rays.as_ref().map(|p| p.display().to_string()).unwrap_or_default()),
+        "triangles": mesh.len(),
+        "frames": a.frames,
+        "threads": threads,
+        "rays": rays.len(),
+        "hits": hit_count,
+        "build_s": build_s,
+        "cast_s": cast_s,
+        "rays_per_s": rays.len() as f64 / cast_s.max(1e-12),
+    });
+    println!("{json}");
+    Ok(())
+}
+
+/// The rays of `frames` frames of rig `name`: each sensor's beams placed by its mount, the vehicle on
+/// the ground at `(frame * 1 m, 0, ego_ground_z_m)`, range limited to the sensor's maximum range.
+fn rig_rays(name: &str, frames: usize, ego_ground_z_m: f32) -> anyhow::Result<Vec<Ray>> {
+    let rig = crate::cli::common::load_rig(name)?;
+    let mut one_frame = Vec::new();
+    for s in &rig.sensors {
+        let vehicle_from_sensor = s.mount.vehicle_from_sensor();
+        let t_max = s.spec.measurement().max_range_m;
+        for f in s.spec.pattern().firings.iter().flatten() {
+            let origin = vehicle_from_sensor.transform_point3(f.origin_in_sensor);
+            let dir = vehicle_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
+            one_frame.push(Ray { origin, dir, t_max });
+        }
+    }
+    if one_frame.len().saturating_mul(frames) > MAX_RAYS {
+        bail!("rig `{name}`: {} rays x {frames} frames is more than {MAX_RAYS} rays", one_frame.len());
+    }
+    let mut rays = Vec::with_capacity(one_frame.len() * frames);
+    for k in 0..frames {
+        let shift = Vec3::new(k as f32 * fixture::FRAME_STEP_M, 0.0, ego_ground_z_m);
+        rays.extend(one_frame.iter().map(|r| Ray { origin: r.origin + shift, ..*r }));
+    }
+    Ok(rays)
+}
+
+/// Reads a raw ray file (see the module doc); directions are normalised, so `t` is metres.
+fn read_ray_file(path: &Path, t_max: f32) -> anyhow::Result<Vec<Ray>> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading ray file {}", path.display()))?;
+    parse_rays(&bytes, t_max).map_err(|m| anyhow::anyhow!("{}: {m}", path.display()))
+}
+
+/// Parses raw ray records; the error message says which record is wrong and why.
+fn parse_rays(bytes: &[u8], t_max: f32) -> Result<Vec<Ray>, String> {
+    if bytes.is_empty() {
+        return Err("no rays (empty file)".into());
+    }
+    if !bytes.len().is_multiple_of(RAY_RECORD_BYTES) {
+        return Err(format!(
+            "length {} bytes is not a multiple of {RAY_RECORD_BYTES} (records of 6 little-endian f32: ox oy oz dx dy dz)",
+            bytes.len()
+        ));
+    }
+    bytes
+        .chunks_exact(RAY_RECORD_BYTES)
+        .enumerate()
+        .map(|(i, rec)| {
+            let v: Vec<f32> = rec.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(format!("ray {i} has a non-finite value {v:?}"));
+            }
+            let dir = Vec3::new(v[3], v[4], v[5]);
+            let len = dir.length();
+            if !(len.is_finite() && len > 1e-20) {
+                return Err(format!("ray {i} has a zero direction"));
+            }
+            Ok(Ray { origin: Vec3::new(v[0], v[1], v[2]), dir: dir / len, t_max })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(v: [f32; 6]) -> Vec<u8> {
+        v.iter().flat_map(|x| x.to_le_bytes()).collect()
+    }
+
+    #[test]
+    fn parses_and_normalises_rays() {
+        let mut b = record([1.0, 2.0, 3.0, 0.0, 0.0, -2.0]);
+        b.extend(record([0.0, 0.0, 0.0, 3.0, 4.0, 0.0]));
+        let rays = parse_rays(&b, 50.0).unwrap();
+        assert_eq!(rays.len(), 2);
+        assert_eq!(rays[0].origin, Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(rays[0].dir, Vec3::new(0.0, 0.0, -1.0));
+        assert!((rays[1].dir - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-6);
+        assert_eq!(rays[1].t_max, 50.0);
+    }
+
+    #[test]
+    fn refuses_bad_records() {
+        let good = record([0.0, 0.0, 1.0, 1.0, 0.0, 0.0]);
+        assert!(parse_rays(&good[..23], 1.0).unwrap_err().contains("not a multiple of 24"));
+        assert!(parse_rays(&[], 1.0).unwrap_err().contains("empty"));
+        let mut b = good.clone();
+        b.extend(record([0.0, f32::NAN, 0.0, 1.0, 0.0, 0.0]));
+        assert!(parse_rays(&b, 1.0).unwrap_err().contains("ray 1 has a non-finite"));
+        assert!(
+            parse_rays(&record([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 1.0)
+                .unwrap_err()
+                .contains("ray 0 has a zero direction")
+        );
+    }
+}
