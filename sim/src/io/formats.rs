@@ -113,10 +113,10 @@ fn write_ply(dir: &Path, stem: &str, cloud: &OrderedCloud) -> Result<Vec<Written
 
 fn write_kitti(dir: &Path, stem: &str, cloud: &OrderedCloud, ctx: &FrameContext) -> Result<Vec<WrittenFile>> {
     let sensor_from_vehicle = ctx.sensor_from_vehicle.as_ref();
-    if let Some(t) = sensor_from_vehicle {
-        if !t.is_finite() || t.matrix3.determinant().abs() < 1e-6 {
-            return Err(SimError::invalid("sensor_from_vehicle", format!("{t:?}"), "a finite rigid transform"));
-        }
+    if let Some(t) = sensor_from_vehicle
+        && (!t.is_finite() || t.matrix3.determinant().abs() < 1e-6)
+    {
+        return Err(SimError::invalid("sensor_from_vehicle", format!("{t:?}"), "a finite rigid transform"));
     }
     let (bin, label, n) = super::kitti::encode(cloud, sensor_from_vehicle)?;
     let (bin_name, label_name) = (format!("{stem}.bin"), format!("{stem}.label"));

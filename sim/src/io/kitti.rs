@@ -78,26 +78,26 @@ pub fn read(bin: &Path, label: Option<&Path>) -> Result<OrderedCloud> {
 
 /// Parses KITTI `.bin` bytes (from `bin_path`) and optional `(label_path, label_bytes)`.
 pub fn read_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<OrderedCloud> {
-    if bin.len() % 16 != 0 {
+    if !bin.len().is_multiple_of(16) {
         return Err(SimError::bad_file(
             bin_path,
             format!("KITTI .bin length {} is not a multiple of 16 bytes (float32 x y z intensity)", bin.len()),
         ));
     }
     let n = bin.len() / 16;
-    if let Some((lp, lb)) = label {
-        if lb.len() != n * 4 {
-            return Err(SimError::bad_file(
-                lp,
-                format!(
-                    ".label holds {} bytes ({} labels{}) but {} has {n} points",
-                    lb.len(),
-                    lb.len() / 4,
-                    if lb.len() % 4 != 0 { " and a partial one" } else { "" },
-                    bin_path.display()
-                ),
-            ));
-        }
+    if let Some((lp, lb)) = label
+        && lb.len() != n * 4
+    {
+        return Err(SimError::bad_file(
+            lp,
+            format!(
+                ".label holds {} bytes ({} labels{}) but {} has {n} points",
+                lb.len(),
+                lb.len() / 4,
+                if !lb.len().is_multiple_of(4) { " and a partial one" } else { "" },
+                bin_path.display()
+            ),
+        ));
     }
     let mut cloud = OrderedCloud::empty(1, n, 1);
     let f = |b: &[u8], k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);

@@ -21,8 +21,8 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use las::point::{Classification, Format};
-use las::{Builder, Point, Transform, Vector, Vlr, Writer};
+use las::point::Format;
+use las::{Builder, PointDataBuilder, Transform, Vector, Vlr, Writer};
 
 use crate::cloud::OrderedCloud;
 use crate::error::{Result, SimError};
@@ -30,6 +30,9 @@ use crate::scene::SemanticClass;
 
 /// Coordinate scale, metres per count.
 pub const SCALE_M: f64 = 0.0001;
+
+/// Bytes per point record: format 6 (30 bytes) plus the 4-byte `instance` extra field.
+const RECORD_BYTES: usize = 34;
 
 /// The ASPRS classification of a return with SemanticKITTI class `label` and ground truth flag
 /// `ground` (see the module docs for the table).
@@ -88,31 +91,40 @@ pub fn encode(path: &Path, cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
     });
     let header = builder.into_header().map_err(|e| las_err(path, e))?;
     let n = cloud.returns();
-    let mut writer =
-        Writer::new(Cursor::new(Vec::with_capacity(n * 34 + 2048)), header).map_err(|e| las_err(path, e))?;
+    // Point records are encoded here (format 6, LAS 1.4 table 15, plus 4 extra bytes) and handed
+    // to the crate as one slab: the crate's per-`Point` path costs ~200 ns a point.
+    let mut records = Vec::with_capacity(n * RECORD_BYTES);
     let cell = cloud.rows * cloud.cols;
     for i in (0..cloud.len()).filter(|&i| cloud.has_return(i)) {
         let p = cloud.point_in_vehicle[i];
+        let mut rec = [0u8; RECORD_BYTES];
+        for (k, v) in [p.x, p.y, p.z].into_iter().enumerate() {
+            let count = (f64::from(v) / SCALE_M).round();
+            if !(count >= f64::from(i32::MIN) && count <= f64::from(i32::MAX)) {
+                return Err(SimError::invalid("point_in_vehicle", v, "|coordinate| <= 214748 m (LAS scale 0.0001 m)"));
+            }
+            rec[4 * k..4 * k + 4].copy_from_slice(&(count as i32).to_le_bytes());
+        }
+        let intensity = (cloud.intensity[i].clamp(0.0, 1.0) * 65535.0).round() as u16;
+        rec[12..14].copy_from_slice(&intensity.to_le_bytes());
         let shot = i % cell.max(1);
-        let returns_in_shot = (0..cloud.planes).filter(|&k| cloud.has_return(k * cell + shot)).count();
-        let point = Point {
-            x: f64::from(p.x),
-            y: f64::from(p.y),
-            z: f64::from(p.z),
-            intensity: (cloud.intensity[i].clamp(0.0, 1.0) * 65535.0).round() as u16,
-            return_number: (cloud.echo[i].saturating_add(1)).min(15),
-            number_of_returns: returns_in_shot.clamp(1, 15) as u8,
-            classification: Classification::new(asprs_class(cloud.label[i], cloud.ground[i]))
-                .map_err(|e| las_err(path, e))?,
-            scanner_channel: cloud.sensor[i].min(3),
-            user_data: cloud.label[i].0.min(255) as u8,
-            point_source_id: cloud.ring[i],
-            gps_time: Some(cloud.time_s[i]),
-            extra_bytes: cloud.instance[i].to_le_bytes().to_vec(),
-            ..Default::default()
-        };
-        writer.write_point(point).map_err(|e| las_err(path, e))?;
+        let returns_in_shot =
+            (0..cloud.planes).filter(|&k| cloud.has_return(k * cell + shot)).count().clamp(1, 15) as u8;
+        let return_number = cloud.echo[i].saturating_add(1).min(15);
+        rec[14] = return_number | (returns_in_shot << 4);
+        rec[15] = cloud.sensor[i].min(3) << 4; // scanner channel in bits 4-5; no flags
+        rec[16] = asprs_class(cloud.label[i], cloud.ground[i]);
+        rec[17] = cloud.label[i].0.min(255) as u8;
+        // rec[18..20]: scan angle 0.
+        rec[20..22].copy_from_slice(&cloud.ring[i].to_le_bytes());
+        rec[22..30].copy_from_slice(&cloud.time_s[i].to_le_bytes());
+        rec[30..34].copy_from_slice(&cloud.instance[i].to_le_bytes());
+        records.extend_from_slice(&rec);
     }
+    let data = PointDataBuilder::new().for_header(&header).build_from_bytes(records).map_err(|e| las_err(path, e))?;
+    let mut writer =
+        Writer::new(Cursor::new(Vec::with_capacity(n * RECORD_BYTES + 2048)), header).map_err(|e| las_err(path, e))?;
+    writer.write_points(&data).map_err(|e| las_err(path, e))?;
     let bytes = writer.into_inner().map_err(|e| las_err(path, e))?.into_inner();
     Ok((bytes, n))
 }

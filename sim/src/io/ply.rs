@@ -2,9 +2,10 @@
 //! point clouds (ours and other tools', ASCII or binary).
 //!
 //! Written vertex properties, in grid order (returns only): `x y z` (float, vehicle frame,
-//! metres), `intensity` (float, `[0, 1]`), `ring` (ushort), `time` (double, seconds), `label`
-//! (ushort, SemanticKITTI class), `instance` (uint), `ground` (uchar 0/1), `nx ny nz` (float, the
-//! true surface normal). The reader returns a `1 x N` [`OrderedCloud`]; properties the file lacks
+//! metres), `intensity` (float, `[0, 1]`), `ring` (int), `time` (double, seconds), `label`
+//! (int, SemanticKITTI class), `instance` (int; ids above 2^31 - 1 are clamped), `ground` (uchar
+//! 0/1), `nx ny nz` (float, the true surface normal). The integer fields are `int` rather than
+//! `ushort`/`uint` because Open3D's PLY reader skips those two types. The reader returns a `1 x N` [`OrderedCloud`]; properties the file lacks
 //! get defaults (intensity 0, ring 0, time 0, label 0, instance 0, ground = whether the label is a
 //! ground class, normal zero); `column` is the vertex index and `range_m` the distance from the origin.
 
@@ -19,7 +20,7 @@ use crate::error::{Result, SimError};
 use crate::scene::SemanticClass;
 
 /// Bytes per written vertex.
-const VERTEX_BYTES: usize = 4 * 4 + 2 + 8 + 2 + 4 + 1 + 3 * 4;
+const VERTEX_BYTES: usize = 4 * 4 + 4 + 8 + 4 + 4 + 1 + 3 * 4;
 
 /// Encodes the returns of `cloud` as a binary little-endian PLY; returns the bytes and the count.
 pub fn encode(cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
@@ -28,7 +29,7 @@ pub fn encode(cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
     let header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment groundtruth frame: returns in grid order, vehicle frame, \
          metres, seconds\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty float \
-         intensity\nproperty ushort ring\nproperty double time\nproperty ushort label\nproperty uint instance\n\
+         intensity\nproperty int ring\nproperty double time\nproperty int label\nproperty int instance\n\
          property uchar ground\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n"
     );
     let mut out = Vec::with_capacity(header.len() + n * VERTEX_BYTES);
@@ -41,14 +42,14 @@ pub fn encode(cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
         rec[4..8].copy_from_slice(&p.y.to_le_bytes());
         rec[8..12].copy_from_slice(&p.z.to_le_bytes());
         rec[12..16].copy_from_slice(&cloud.intensity[i].to_le_bytes());
-        rec[16..18].copy_from_slice(&cloud.ring[i].to_le_bytes());
-        rec[18..26].copy_from_slice(&cloud.time_s[i].to_le_bytes());
-        rec[26..28].copy_from_slice(&cloud.label[i].0.to_le_bytes());
-        rec[28..32].copy_from_slice(&cloud.instance[i].to_le_bytes());
-        rec[32] = u8::from(cloud.ground[i]);
-        rec[33..37].copy_from_slice(&nrm.x.to_le_bytes());
-        rec[37..41].copy_from_slice(&nrm.y.to_le_bytes());
-        rec[41..45].copy_from_slice(&nrm.z.to_le_bytes());
+        rec[16..20].copy_from_slice(&i32::from(cloud.ring[i]).to_le_bytes());
+        rec[20..28].copy_from_slice(&cloud.time_s[i].to_le_bytes());
+        rec[28..32].copy_from_slice(&i32::from(cloud.label[i].0).to_le_bytes());
+        rec[32..36].copy_from_slice(&(cloud.instance[i].min(i32::MAX as u32) as i32).to_le_bytes());
+        rec[36] = u8::from(cloud.ground[i]);
+        rec[37..41].copy_from_slice(&nrm.x.to_le_bytes());
+        rec[41..45].copy_from_slice(&nrm.y.to_le_bytes());
+        rec[45..49].copy_from_slice(&nrm.z.to_le_bytes());
         out.extend_from_slice(&rec);
     }
     Ok((out, n))

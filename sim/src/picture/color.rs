@@ -13,7 +13,7 @@ pub enum Coloring<'a> {
     Ground,
     /// Measured range (viridis, 0 to the 98th percentile).
     Range,
-    /// Height `z` in the vehicle frame (viridis, 2nd to 98th percentile).
+    /// Height `z` in the vehicle frame (viridis, 2nd to 98th percentile, at least 1 m of span).
     Height,
     /// A classifier's result against ground truth, given its predicted-ground flag per cell
     /// (`planes * rows * cols` entries): true ground, false ground, missed ground, true non-ground.
@@ -119,7 +119,15 @@ pub(crate) fn paint(cloud: &OrderedCloud, coloring: &Coloring) -> Result<(Vec<Op
             let values: Vec<f32> = hits.iter().map(|&i| value(i)).collect();
             let lo = if is_range { 0.0 } else { quantile(values.clone(), 0.02).unwrap_or(0.0) };
             let hi = quantile(values, 0.98).unwrap_or(1.0);
-            let hi = if hi > lo { hi } else { lo + 1.0 };
+            // At least 1 m of span, so that flat ground reads as one colour rather than noise.
+            let (lo, hi) = if hi - lo >= 1.0 {
+                (lo, hi)
+            } else if is_range {
+                (lo, lo + 1.0)
+            } else {
+                let mid = 0.5 * (lo + hi);
+                (mid - 0.5, mid + 0.5)
+            };
             for &i in &hits {
                 colors[i] = Some(viridis((value(i) - lo) / (hi - lo)));
             }

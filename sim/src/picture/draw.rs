@@ -62,13 +62,16 @@ pub(crate) fn nice_floor(x: f32) -> f32 {
     }
 }
 
-fn legend_items(legend: &Legend) -> Vec<(u32, Box<dyn Fn(&mut RgbImage, i64, i64) + '_>)> {
+/// Draws one legend item with its top-left corner at `(x, y)`.
+type DrawItem<'a> = Box<dyn Fn(&mut RgbImage, i64, i64) + 'a>;
+
+fn legend_items(legend: &Legend) -> Vec<(u32, DrawItem<'_>)> {
     match legend {
         Legend::Swatches(items) => items
             .iter()
             .map(|(c, name)| {
                 let w = 12 + 8 * name.chars().count() as u32 + 12;
-                let f: Box<dyn Fn(&mut RgbImage, i64, i64)> = Box::new(move |img, x, y| {
+                let f: DrawItem = Box::new(move |img, x, y| {
                     fill_rect(img, x, y, 9, 9, *c);
                     text(img, x + 12, y + 1, name, TEXT);
                 });
@@ -77,11 +80,12 @@ fn legend_items(legend: &Legend) -> Vec<(u32, Box<dyn Fn(&mut RgbImage, i64, i64
             .collect(),
         Legend::Ramp { title, lo, hi } => {
             let unit = " m";
-            let left = format!("{title} {lo:.1}");
-            let right = format!("{hi:.1}{unit}");
+            let digits = if hi - lo < 10.0 { 2 } else { 1 };
+            let left = format!("{title} {lo:.digits$}");
+            let right = format!("{hi:.digits$}{unit}");
             let bar = 128u32;
             let w = 8 * (left.len() + right.len()) as u32 + bar + 16 + 12;
-            let f: Box<dyn Fn(&mut RgbImage, i64, i64)> = Box::new(move |img, x, y| {
+            let f: DrawItem = Box::new(move |img, x, y| {
                 let lw = text(img, x, y + 1, &left, TEXT);
                 let bx = x + i64::from(lw) + 8;
                 for k in 0..bar {
@@ -108,7 +112,9 @@ pub(crate) fn with_footer(plot: &RgbImage, legend: &Legend, scale: Option<&Scale
             lines.push(Vec::new());
             x = 8;
         }
-        lines.last_mut().map(|l| l.push(k));
+        if let Some(l) = lines.last_mut() {
+            l.push(k);
+        }
         x += w;
     }
     let last_used: u32 = 8 + lines.last().map_or(0, |l| l.iter().map(|&k| items[k].0).sum());

@@ -1,0 +1,104 @@
+//! Every reader (PCD, PLY cloud, PLY mesh, KITTI `.bin` + `.label`) given arbitrary bytes, a
+//! truncated valid file or a valid file with corrupted bytes returns a value or an error, never
+//! panics; and a truncated binary file is always refused.
+
+use std::path::Path;
+
+use glam::Vec3;
+use proptest::prelude::*;
+use sim::io::{kitti, pcd, ply};
+use sim::scene::ply::{read_mesh_bytes, write_mesh};
+use sim::{OrderedCloud, SceneMesh, SemanticClass, Surface};
+
+fn small_cloud() -> OrderedCloud {
+    let mut c = OrderedCloud::empty(3, 5, 1);
+    for i in 0..c.len() {
+        if i % 4 != 0 {
+            c.point_in_vehicle[i] = Vec3::new(i as f32, 1.0, -0.5);
+            c.range_m[i] = c.point_in_vehicle[i].length();
+            c.label[i] = SemanticClass::ROAD;
+            c.ground[i] = true;
+        }
+    }
+    c
+}
+
+fn valid_files() -> Vec<(&'static str, Vec<u8>)> {
+    let c = small_cloud();
+    let mut mesh = SceneMesh::new();
+    mesh.push_box(Vec3::ZERO, Vec3::ONE, Surface::object(SemanticClass::CAR, 2));
+    let dir = tempfile::tempdir().unwrap();
+    let mesh_path = dir.path().join("m.ply");
+    write_mesh(&mesh_path, &mesh).unwrap();
+    let (bin, label, _) = kitti::encode(&c, None).unwrap();
+    let mut kitti_both = bin.clone();
+    kitti_both.extend_from_slice(&label);
+    vec![
+        ("pcd", pcd::encode(&c, false).unwrap()),
+        ("pcd", pcd::encode(&c, true).unwrap()),
+        ("ply", ply::encode(&c).unwrap().0),
+        ("mesh", std::fs::read(&mesh_path).unwrap()),
+        ("kitti", kitti_both),
+    ]
+}
+
+/// Runs the reader named `kind` on `bytes`; `Ok` or `Err` are both fine, only a panic fails.
+fn read_any(kind: &str, bytes: &[u8]) -> bool {
+    let p = Path::new("fuzz.bin");
+    match kind {
+        "pcd" => pcd::read_bytes(p, bytes).is_ok(),
+        "ply" => ply::read_bytes(p, bytes).is_ok(),
+        "mesh" => read_mesh_bytes(p, bytes).is_ok(),
+        _ => {
+            // Split the bytes into a .bin part (multiple of 16 when possible) and a .label part.
+            let split = bytes.len() * 4 / 5 / 16 * 16;
+            kitti::read_bytes(p, &bytes[..split], Some((Path::new("fuzz.label"), &bytes[split..]))).is_ok()
+        }
+    }
+}
+
+const KINDS: [&str; 4] = ["pcd", "ply", "mesh", "kitti"];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    #[test]
+    fn arbitrary_bytes_never_panic(kind in 0usize..4, bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
+        read_any(KINDS[kind], &bytes);
+    }
+
+    #[test]
+    fn header_prefixed_garbage_never_panics(which in 0usize..5, keep in 0usize..400, tail in proptest::collection::vec(any::<u8>(), 0..300)) {
+        let files = valid_files();
+        let (kind, bytes) = &files[which];
+        let mut b = bytes[..keep.min(bytes.len())].to_vec();
+        b.extend_from_slice(&tail);
+        read_any(kind, &b);
+    }
+
+    #[test]
+    fn truncations_are_refused(which in 0usize..5, cut in 1usize..2000) {
+        let files = valid_files();
+        let (kind, bytes) = &files[which];
+        prop_assert!(read_any(kind, bytes), "the untouched file reads");
+        let cut = cut.min(bytes.len());
+        let truncated = &bytes[..bytes.len() - cut];
+        let ok = read_any(kind, truncated);
+        // A cut ASCII file may still parse (`0.25` cut to `0.2`); KITTI has no header to disagree with.
+        if *kind != "kitti" && which != 1 {
+            prop_assert!(!ok, "{kind} cut by {cut} bytes must be refused");
+        }
+    }
+
+    #[test]
+    fn corrupted_bytes_never_panic(which in 0usize..5, edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
+        let files = valid_files();
+        let (kind, bytes) = &files[which];
+        let mut b = bytes.clone();
+        for (at, v) in edits {
+            let k = at.index(b.len());
+            b[k] = v;
+        }
+        read_any(kind, &b);
+    }
+}
