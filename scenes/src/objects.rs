@@ -205,7 +205,7 @@ pub fn bush(mesh: &mut SceneMesh, ids: &mut Ids, base: Vec3, radius_m: f32, heig
         pose(base, 0.0),
         c,
         Vec3::new(radius_m, radius_m, half),
-        (5, 8),
+        (4, 8),
         Surface::object(SemanticClass::VEGETATION, id),
     );
     id
