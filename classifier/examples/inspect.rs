@@ -9,7 +9,25 @@ fn main() {
     let mut m = Nitsch::new(NitschParams::default()).unwrap();
     let g = m.classify(&cloud).unwrap();
     println!("rows {} cols {} planes {} wrap {}", cloud.rows, cloud.cols, cloud.planes, m.view(&cloud).wrap);
-    dump(&cloud, &m, &g, 4, 5);
+    if std::env::args().nth(2).is_some() {
+        dump(&cloud, &m, &g, 8, 5);
+    }
+    let mut seen = std::collections::BTreeMap::new();
+    for i in 0..cloud.rows * cloud.cols {
+        if cloud.ground[i]
+            && !g[i]
+            && let Some(root) = m.workspace.cluster_of(i)
+        {
+            *seen.entry(root).or_insert(0) += 1;
+        }
+    }
+    for (root, missed) in seen {
+        let (size, inside, h, dec) = m.workspace.cluster_summary(root);
+        let p = cloud.point_in_vehicle[root];
+        println!(
+            "missed {missed:4} in cluster {root}: size {size} inside {inside} height {h:.2} ground {dec} at {p:?}"
+        );
+    }
     for r in 0..cloud.rows {
         let (mut ret, mut gt, mut tp, mut fp, mut fn_, mut cand_fn, mut gsum) = (0, 0, 0, 0, 0, 0, 0.0);
         for c in 0..cloud.cols {

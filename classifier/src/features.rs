@@ -11,24 +11,20 @@
 //! - A cell with fewer than `min_valid_pairs` pair normals (isolated returns, a corner of the grid)
 //!   gets `n = 0`, `n_rho = 0` and `g_rho = 0`: it is never a ground candidate.
 //! - Cells without a return get the same zeros.
-//! - Occlusion (tested): a neighbour whose measured range is less than `1 - occlusion_ratio`
-//!   (default 0.8) times the cell's is an occluder in front of it (a car's bumper above ground
-//!   seen under the car, an object's edge beside the ground behind it) and is left out. This is a
-//!   ratio of ranges, so unlike the fixed distance threshold the paper rejects it does not depend
-//!   on the mounting height, the pitch or the range. On ground, upper and lateral neighbours are
-//!   never nearer; lower neighbours are nearer by about `range * beam gap / height`, so far away
-//!   (beyond about 20 m for a 0.8 degree gap at 1.6 m) the lower pairs drop out and the upper and
-//!   lateral ones remain. The upper neighbours (`d8`, `d1`, `d2`) use a tighter ratio
-//!   (`upper_occlusion_ratio`, default 0.05): on ground they are farther than the cell, on a wall
-//!   below the horizon nearer by well under 5 % (`cos` of the beam gap), so an upper neighbour
-//!   nearer than that is an occluder (measured: ground seen under cars on `city`).
-//! - The pair normals enter Eq. 2 as *unit* vectors. Taken literally, `|d_i x d_(i-1)|` grows
-//!   with the product of the neighbour distances, which would make the weighted mean rely *more*
-//!   on far neighbours, against the paper's stated aim ("rely more on physically closer points",
-//!   "one neighboring point is meters off ... due to reflections"). With unit pair normals the
-//!   weight `1 / (|d_i| + |d_(i-1)|)` does what the text says. This matters at occlusion edges:
-//!   a ground point whose upper neighbours lie on a car metres in front of it keeps an upward
-//!   normal (measured on `city` with `lux-roof-4`).
+//! - The pair normals enter Eq. 2 as the paper writes them, `d_i x d_(i-1)` (not unit vectors).
+//!   Unit pair normals were tried (the text's aim is to "rely more on physically closer points")
+//!   and rejected: nearly collinear pairs of far neighbours then get a full vote, which lost a
+//!   quarter of the far-side terrain in the basin test.
+//! - Occlusion (tested): a neighbour whose measured range is less than `1 - ratio` times the
+//!   cell's is an occluder in front of it (a car's bumper above ground seen under the car) and is
+//!   left out. This is a ratio of ranges, so unlike the fixed distance threshold the paper rejects
+//!   it does not depend on the mounting height, the pitch or the range. Only the neighbours in the
+//!   row above (`d8`, `d1`, `d2`) are tested by default (`upper_occlusion_ratio` 0.05): on ground
+//!   they are farther than the cell, on a wall below the horizon nearer by well under 5 %, so an
+//!   upper neighbour nearer than that is an occluder (measured: ground seen under cars on `city`
+//!   with `lux-roof-4`). The same test on all neighbours (`occlusion_ratio`, 0 = off, the default)
+//!   drops the lower neighbours of far ground, which are naturally nearer by about
+//!   `range * beam gap / height`.
 
 use glam::Vec3;
 
@@ -55,7 +51,7 @@ impl Default for FeatureParams {
         Self {
             min_valid_pairs: 2,
             max_neighbour_distance_m: f32::INFINITY,
-            occlusion_ratio: 0.2,
+            occlusion_ratio: 0.0,
             upper_occlusion_ratio: 0.05,
         }
     }
@@ -106,16 +102,10 @@ pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut F
     out.resize(rows * cols);
     let max_d2 = params.max_neighbour_distance_m * params.max_neighbour_distance_m;
     let min_pairs = params.min_valid_pairs;
-    let keep = [
-        1.0 - params.upper_occlusion_ratio,
-        1.0 - params.upper_occlusion_ratio,
-        1.0 - params.occlusion_ratio,
-        1.0 - params.occlusion_ratio,
-        1.0 - params.occlusion_ratio,
-        1.0 - params.occlusion_ratio,
-        1.0 - params.occlusion_ratio,
-        1.0 - params.upper_occlusion_ratio,
-    ];
+    // Ratio 0 switches the test off (keep every neighbour: factor 0).
+    let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
+    let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
+    let keep = [up, up, other, other, other, other, other, up];
     for r in 0..rows {
         for c in 0..cols {
             let i = r * cols + c;
@@ -182,9 +172,8 @@ fn pair_features(dx: &[f32; 8], dy: &[f32; 8], dz: &[f32; 8], ok: &[f32; 8], min
         // A pair exists when both neighbours do and the cross product is not degenerate.
         let valid = ok[k] * pok[k] * f32::from(u8::from(nl > 1e-12 * len[k] * plen[k]));
         // Eq. 2 weight 1 / (|d_i| + |d_(i-1)|); Eq. 3 needs 1 / |n_i|.
-        // The pair normals enter Eq. 2 as unit vectors (see the module docs), hence `inv` in `w`.
         inv[k] = valid / nl.max(f32::MIN_POSITIVE);
-        w[k] = inv[k] / (len[k] + plen[k]).max(f32::MIN_POSITIVE);
+        w[k] = valid / (len[k] + plen[k]).max(f32::MIN_POSITIVE);
     }
     let (mut sx, mut sy, mut sz, mut pairs) = (0f32, 0f32, 0f32, 0f32);
     for k in 0..8 {

@@ -77,7 +77,8 @@ pub struct Nitsch {
     pub params: NitschParams,
     /// Features of the last frame's plane 0.
     pub features: Features,
-    workspace: ClusterWorkspace,
+    /// Clusters of the last frame (diagnostics).
+    pub workspace: ClusterWorkspace,
     candidate: Vec<bool>,
     plane0_ground: Vec<bool>,
     /// Stage times of the last frame.

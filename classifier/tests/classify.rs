@@ -69,8 +69,7 @@ fn basin_far_side_terrain_is_ground() {
     let cloud = SyntheticSensor::spinning(32, 720, -25.0, 2.0, 1.8).scan(&basin_scene());
     let far: Vec<usize> = (0..cloud.len()).filter(|&i| cloud.label[i] == SemanticClass::TERRAIN).collect();
     assert!(far.len() > 200, "far-side cells: {}", far.len());
-    let mut m = nitsch(0.6, true);
-    let ground = m.classify(&cloud).unwrap();
+    let ground = nitsch(0.6, true).classify(&cloud).unwrap();
     let hit = far.iter().filter(|&&i| ground[i]).count();
     assert!(hit as f64 > 0.95 * far.len() as f64, "{hit} of {} far-side cells ground", far.len());
     // The basin walls are not ground.

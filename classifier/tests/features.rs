@@ -149,3 +149,27 @@ fn wrap_is_detected_for_full_turns_only_and_joins_the_seam() {
     let (d1, d2) = (spin.point_in_vehicle[3 * 180 + 179], spin.point_in_vehicle[3 * 180]);
     assert!(d1.distance(d2) < 0.3, "seam columns are physical neighbours");
 }
+
+#[test]
+fn an_upper_neighbour_in_front_of_the_cell_is_an_occluder() {
+    let sensor = SyntheticSensor::forward(6, 40, -20.0, -10.0, 40.0, 1.8);
+    let mut cloud = sensor.scan(&[flat_ground()]);
+    let (r, c) = (2, 20);
+    let i = r * 40 + c;
+    // Put the three upper neighbours on an object 30 % nearer and 0.4 m up (a bumper seen above
+    // the ground under a car).
+    for cc in c - 1..=c + 1 {
+        let j = (r + 1) * 40 + cc;
+        let p = cloud.point_in_vehicle[j];
+        let origin = sensor.origin;
+        let q = origin + (p - origin) * 0.7;
+        cloud.point_in_vehicle[j] = Vec3::new(q.x, q.y, 0.4);
+        cloud.range_m[j] = (cloud.point_in_vehicle[j] - origin).length();
+    }
+    let with = features(&cloud, false, FeatureParams::default());
+    let without = features(&cloud, false, FeatureParams { upper_occlusion_ratio: 0.0, ..Default::default() });
+    assert!(with.g_rho[i] > 0.99, "occluders left out: g_rho {}", with.g_rho[i]);
+    assert!(without.g_rho[i] < 0.6, "occluders kept: g_rho {}", without.g_rho[i]);
+    // Ratio checks are refused outside [0, 1).
+    assert!(FeatureParams { occlusion_ratio: 1.0, ..Default::default() }.validate().is_err());
+}

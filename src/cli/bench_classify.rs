@@ -36,7 +36,8 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;
-    let config = ScanConfig { seed: args.seed, frames: args.frames, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
+    let config =
+        ScanConfig { seed: args.seed, frames: args.frames, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
     let frames = sim::scan::scan(&scene.mesh, &rig, &config).context("scanning")?;
     let mut method = method_by_name(&args.method, args.seed)?;
     let repeats = args.repeats.max(1);

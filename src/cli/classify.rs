@@ -71,11 +71,7 @@ fn list_inputs(input: &Path) -> anyhow::Result<Vec<InputFrame>> {
             .map(|f| {
                 let rows = f.world_from_vehicle;
                 let mat = Mat4::from_cols_array_2d(&rows).transpose();
-                InputFrame {
-                    index: f.index,
-                    path: input.join(&f.file),
-                    pose: Some(Affine3A::from_mat4(mat)),
-                }
+                InputFrame { index: f.index, path: input.join(&f.file), pose: Some(Affine3A::from_mat4(mat)) }
             })
             .collect());
     }

@@ -22,7 +22,10 @@ pub struct Args {
     #[arg(long)]
     rig: String,
     /// Comma-separated method names (see `groundtruth list`).
-    #[arg(long, default_value = "nitsch,nitsch-0.7,nitsch-no-cluster,nitsch-no-cluster-0.7,ransac,grid,grid-no-cluster")]
+    #[arg(
+        long,
+        default_value = "nitsch,nitsch-0.7,nitsch-no-cluster,nitsch-no-cluster-0.7,ransac,grid,grid-no-cluster"
+    )]
     methods: String,
     /// Number of frames to scan.
     #[arg(long, default_value_t = 5)]
@@ -89,11 +92,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             );
             for (id, c) in &eval.by_class {
                 let called = c.tp + c.fp;
-                println!("  class {:<18} points {:>8} called ground {:>8}", Evaluation::class_name(*id), c.total(), called);
+                println!(
+                    "  class {:<18} points {:>8} called ground {:>8}",
+                    Evaluation::class_name(*id),
+                    c.total(),
+                    called
+                );
             }
             for (b, c) in eval.by_range.iter().enumerate() {
                 let s = c.scores();
-                println!("  range {:<10} points {:>8} acc {:.4} FPR {:.4} F1 {:.4}", range_band_name(b), c.total(), s.acc, s.fpr, s.f1);
+                println!(
+                    "  range {:<10} points {:>8} acc {:.4} FPR {:.4} F1 {:.4}",
+                    range_band_name(b),
+                    c.total(),
+                    s.acc,
+                    s.fpr,
+                    s.f1
+                );
             }
         }
         json.insert(name.clone(), s);
