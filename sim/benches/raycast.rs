@@ -1,6 +1,7 @@
 //! Ray casting speed on the 1.3 M-triangle fixture terrain with one 128 x 2048 spinning-LiDAR frame
-//! (262,144 rays): the BVH backend (binary and wide layouts, with and without the coherence seed,
-//! on 1 and 2 threads) and the parry reference. `cargo bench -p sim --bench raycast`.
+//! (262,144 rays): the BVH backend (the 4-wide tree with fan traversal, one ray at a time with and
+//! without the previous-hit seed, obvhs's own BVH2 and CWBVH traversals; 1 and 2 threads) and the
+//! parry reference. `cargo bench -p sim --bench raycast`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sim::cast::{BvhCaster, BvhLayout, BvhOptions, Caster, ParryCaster, fixture};
@@ -11,10 +12,14 @@ fn raycast(c: &mut Criterion) {
     let mut g = c.benchmark_group("raycast_fixture_frame");
     g.throughput(Throughput::Elements(rays.len() as u64));
     g.sample_size(10);
+    let single = BvhOptions { packet_rays: 0, coherent: false, ..BvhOptions::default() };
     let variants = [
-        ("bvh", BvhOptions::default()),
-        ("bvh-no-coherence", BvhOptions { coherent: false, ..BvhOptions::default() }),
-        ("cwbvh", BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() }),
+        ("bvh4-fan16", BvhOptions::default()),
+        ("bvh4-fan8", BvhOptions { packet_rays: 8, ..BvhOptions::default() }),
+        ("bvh4-single", single),
+        ("bvh4-single-seeded", BvhOptions { coherent: true, ..single }),
+        ("obvhs-bvh2", BvhOptions { layout: BvhLayout::Binary, ..single }),
+        ("obvhs-cwbvh", BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..single }),
     ];
     for (name, options) in variants {
         let caster = BvhCaster::with_options(&mesh, options);

@@ -88,7 +88,8 @@ fn bvh_matches_parry_on_random_scene() {
     let expected: Vec<Option<Hit>> = rays.iter().map(|r| reference.cast(r)).collect();
     for options in [
         BvhOptions::default(),
-        BvhOptions { coherent: false, ..BvhOptions::default() },
+        BvhOptions { coherent: false, packet_rays: 0, ..BvhOptions::default() },
+        BvhOptions { layout: BvhLayout::Binary, ..BvhOptions::default() },
         BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() },
     ] {
         let bvh = BvhCaster::with_options(&mesh, options);
@@ -182,6 +183,33 @@ fn assert_no_leaks(caster: &dyn Caster, rays: &[Ray], sx: f32, sy: f32, name: &s
     assert_eq!(leaks, 0, "{name}: {leaks} of {} rays leaked", rays.len());
 }
 
+/// Fans of 16 rays sharing an origin above a grid vertex, all inside the vertical plane of a grid
+/// line (along x, along y, or along the cells' shared diagonals), at 16 depression angles: every ray
+/// of a fan runs exactly over a line of shared edges and vertices (the case `cast_batch` traverses
+/// as a fan).
+fn edge_fans(n: usize, slope_x: f32, slope_y: f32, fans: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let lim = n as i32 / 4;
+    let mut rays = Vec::with_capacity(fans * 16);
+    for _ in 0..fans {
+        let (i, j) = (rng.random_range(-lim..lim) as f32, rng.random_range(-lim..lim) as f32);
+        let origin = Vec3::new(i, j, slope_x * i + slope_y * j + rng.random_range(0.5..10.0));
+        let (dx, dy) =
+            [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (1.0, 1.0), (-1.0, -1.0)][rng.random_range(0..6)];
+        let normal = Vec3::new(-slope_x, -slope_y, 1.0).normalize();
+        for k in 0..16 {
+            let dir = Vec3::new(dx, dy, -0.15 - 0.1 * k as f32).normalize();
+            let ray = Ray { origin, dir, t_max: f32::INFINITY };
+            let p = origin + plane_t(&ray, slope_x, slope_y) as f32 * dir;
+            let inside = p.x.abs().max(p.y.abs()) < n as f32 / 2.0 - 1.0;
+            if inside && dir.dot(normal).abs() >= 0.1 {
+                rays.push(ray);
+            }
+        }
+    }
+    rays
+}
+
 #[test]
 fn grid_edges_and_vertices_never_leak() {
     for (sx, sy) in [(0.0, 0.0), (0.25, -0.125)] {
@@ -191,6 +219,10 @@ fn grid_edges_and_vertices_never_leak() {
         let wide = BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() };
         assert_no_leaks(&BvhCaster::with_options(&mesh, wide), &rays, sx, sy, "bvh-wide");
         assert_no_leaks(&ParryCaster::new(&mesh), &rays[..50_000], sx, sy, "parry");
+        let fans = edge_fans(96, sx, sy, 4000, 9);
+        assert!(fans.len() > 20_000, "{} fan rays", fans.len());
+        assert_no_leaks(&BvhCaster::new(&mesh), &fans, sx, sy, "bvh-fans");
+        assert_no_leaks(&ParryCaster::new(&mesh), &fans[..10_000], sx, sy, "parry-fans");
     }
 }
 
@@ -222,18 +254,39 @@ fn ideal_rays_hit_the_analytic_point_on_a_plane() {
     assert_eq!(ParryCaster::new(&mesh).cast(&far), None);
 }
 
+/// Spinning-LiDAR rays (fans of beams sharing an origin, the coherent case `cast_batch` traverses
+/// as fans) from a few origins: `rows x cols` per origin, row-major.
+fn lidar_rays(origins: &[Vec3], row_step: usize, col_step: usize, t_max: f32) -> Vec<Ray> {
+    let mut rays = Vec::new();
+    for &origin in origins {
+        for r in (0..fixture::LIDAR_ROWS).step_by(row_step) {
+            for c in (0..fixture::LIDAR_COLS).step_by(col_step) {
+                rays.push(Ray { origin, dir: fixture::beam_dir(r, c), t_max });
+            }
+        }
+    }
+    rays
+}
+
+#[test]
+fn bvh_fans_match_parry_on_lidar_rays() {
+    let mesh = random_scene(8);
+    let rays = lidar_rays(&[Vec3::new(0.5, 0.25, 3.0), Vec3::new(-10.0, 7.0, 1.0)], 4, 2, f32::INFINITY);
+    let reference = ParryCaster::new(&mesh);
+    let expected: Vec<Option<Hit>> = rays.iter().map(|r| reference.cast(r)).collect();
+    for packet_rays in [0, 4, 8, 16, 32] {
+        let bvh = BvhCaster::with_options(&mesh, BvhOptions { packet_rays, ..BvhOptions::default() });
+        let (hits, ties) = compare(&mesh, &rays, &bvh.cast_all(&rays), &expected);
+        assert!(hits > 20_000 && hits < 60_000, "packet_rays {packet_rays}: {hits} hits of {}", rays.len());
+        assert!(ties < 100, "{ties} ties");
+    }
+}
+
 #[test]
 fn cast_all_is_identical_on_one_and_two_threads() {
     let mesh = random_scene(21);
     // A spinning-LiDAR pattern (coherent rays, where cast_batch reuses the previous hit).
-    let origin = Vec3::new(0.5, 0.25, 3.0);
-    let mut rays: Vec<Ray> = (0..32)
-        .flat_map(|r| (0..512).map(move |c| (r, c)))
-        .map(|(r, c)| {
-            let d = fixture::beam_dir(r * 4, c * 4);
-            Ray { origin, dir: d, t_max: 80.0 }
-        })
-        .collect();
+    let mut rays = lidar_rays(&[Vec3::new(0.5, 0.25, 3.0)], 4, 4, 80.0);
     rays.extend(random_rays(4, 10_000));
     let caster = BvhCaster::new(&mesh);
     let run = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| caster.cast_all(&rays));

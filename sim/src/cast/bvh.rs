@@ -23,6 +23,7 @@ use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use obvhs::ray::{Ray as ORay, RayHit};
 
 use super::watertight::RayPre;
+use super::wide4::{PACKET, Wide4};
 use super::{Caster, Hit, Ray};
 use crate::scene::SceneMesh;
 
@@ -30,10 +31,13 @@ use crate::scene::SceneMesh;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BvhLayout {
     /// Binary BVH (obvhs `Bvh2`, leaves of up to [`BvhOptions::max_prims_per_leaf`] triangles).
-    #[default]
     Binary,
     /// Compressed wide BVH8 (obvhs `CwBvh`, SIMD node tests, up to 3 triangles per leaf).
     Wide,
+    /// 4-wide BVH collapsed from the obvhs `Bvh2`, with this crate's nearest-first traversal
+    /// (structure-of-arrays slab tests of four children at once; see `wide4.rs`). The fastest.
+    #[default]
+    Four,
 }
 
 /// Build and traversal options of [`BvhCaster`] (the defaults are the fastest measured).
@@ -43,6 +47,10 @@ pub struct BvhOptions {
     pub layout: BvhLayout,
     /// Test the previous ray's hit triangle first in [`Caster::cast_batch`].
     pub coherent: bool,
+    /// Traverse groups of this many consecutive rays together in [`Caster::cast_batch`] (layout
+    /// [`BvhLayout::Four`] only; 4, 8, 16 or 32; 0 or 1: one ray at a time). A group that shares one
+    /// origin and one direction octant is traversed as a fan (interval slab tests, see `wide4.rs`).
+    pub packet_rays: usize,
     /// Largest number of triangles per leaf (binary: 1..=255, wide: 1..=3).
     pub max_prims_per_leaf: u32,
     /// Fraction of nodes considered for reinsertion after the PLOC build (0 = none).
@@ -51,7 +59,13 @@ pub struct BvhOptions {
 
 impl Default for BvhOptions {
     fn default() -> Self {
-        Self { layout: BvhLayout::Binary, coherent: true, max_prims_per_leaf: 4, reinsertion_ratio: 0.02 }
+        Self {
+            layout: BvhLayout::Four,
+            coherent: true,
+            packet_rays: 16,
+            max_prims_per_leaf: 4,
+            reinsertion_ratio: 0.02,
+        }
     }
 }
 
@@ -59,6 +73,7 @@ enum Tree {
     Empty,
     Binary(Bvh2),
     Wide(CwBvh),
+    Four(Wide4),
 }
 
 /// Production caster: obvhs BVH + watertight triangles; rayon over rays in [`Caster::cast_all`].
@@ -116,7 +131,16 @@ impl BvhCaster {
                 let idx = std::mem::take(&mut cw.primitive_indices);
                 (Tree::Wide(cw), idx)
             }
+            BvhLayout::Four => {
+                collapse(&mut bvh2, options.max_prims_per_leaf.clamp(1, 255), 3.0);
+                (Tree::Four(Wide4::from_bvh2(&bvh2, |i| mesh.triangle(i as usize))), Vec::new())
+            }
         };
+        if let Tree::Four(mut w) = tree {
+            let tris = std::mem::take(&mut w.tris);
+            let order = std::mem::take(&mut w.order_to_triangle);
+            return Self { tree: Tree::Four(w), tris, order_to_triangle: order, options, pad_m };
+        }
         let tris = indices.iter().map(|&i| mesh.triangle(i as usize)).collect();
         Self { tree, tris, order_to_triangle: indices, options, pad_m }
     }
@@ -133,7 +157,16 @@ impl BvhCaster {
 
     /// Closest hit with an optional seed: `(bvh-order index, t)` of a hit already known.
     #[inline(always)]
-    fn cast_seeded(&self, ray: &Ray, pre: &RayPre, seed: Option<(u32, f32)>) -> Option<(u32, f32)> {
+    fn cast_seeded(
+        &self,
+        ray: &Ray,
+        pre: &RayPre,
+        seed: Option<(u32, f32)>,
+        stack: &mut Vec<(u32, f32)>,
+    ) -> Option<(u32, f32)> {
+        if let Tree::Four(w) = &self.tree {
+            return w.cast(pre, ray.dir, &self.tris, seed, stack);
+        }
         let limit = seed.map_or(ray.t_max, |(_, t)| t);
         // obvhs accepts `t < ray.tmax`: widen by one ulp for an inclusive `t_max` when unseeded,
         // stay strict against a seed (a tie keeps the seed).
@@ -149,8 +182,52 @@ impl BvhCaster {
             Tree::Empty => false,
             Tree::Binary(b) => b.ray_traverse(o, &mut hit, test),
             Tree::Wide(w) => w.ray_traverse(o, &mut hit, test),
+            Tree::Four(_) => false, // Handled above.
         };
         if found { Some((hit.primitive_id, hit.t)) } else { seed }
+    }
+
+    /// [`Caster::cast_batch`] for the 4-wide tree, `N` rays at a time.
+    fn batch_packets<const N: usize>(
+        &self,
+        w: &Wide4,
+        rays: &[Ray],
+        out: &mut [Option<Hit>],
+        stack: &mut Vec<(u32, f32)>,
+    ) {
+        let mut prev: [Option<u32>; N] = [None; N];
+        for (rs, os) in rays.chunks(N).zip(out.chunks_mut(N)) {
+            let Ok(rs) = <&[Ray; N]>::try_from(rs) else {
+                for (r, o) in rs.iter().zip(os.iter_mut()) {
+                    *o = self.cast(r);
+                }
+                continue;
+            };
+            let pres: [RayPre; N] = std::array::from_fn(|i| RayPre::new(&rs[i]));
+            let dirs: [Vec3; N] = std::array::from_fn(|i| rs[i].dir);
+            let mut best: [Option<(u32, f32)>; N] = [None; N];
+            if self.options.coherent {
+                for i in 0..N {
+                    best[i] = prev[i].and_then(|p| {
+                        let [a, b, c] = self.tris[p as usize];
+                        pres[i].intersect(a, b, c, rs[i].t_max).map(|t| (p, t))
+                    });
+                }
+            }
+            if !w.cast_fan(&pres, &dirs, &self.tris, &mut best, stack) {
+                for (q, (p4, d4)) in pres.chunks_exact(PACKET).zip(dirs.chunks_exact(PACKET)).enumerate() {
+                    let p4: &[RayPre; PACKET] = p4.try_into().expect("chunks_exact gives PACKET rays");
+                    let d4: &[Vec3; PACKET] = d4.try_into().expect("chunks_exact gives PACKET rays");
+                    let mut b4: [Option<(u32, f32)>; PACKET] = std::array::from_fn(|i| best[q * PACKET + i]);
+                    w.cast_packet(p4, d4, &self.tris, &mut b4, stack);
+                    best[q * PACKET..(q + 1) * PACKET].copy_from_slice(&b4);
+                }
+            }
+            for i in 0..N {
+                prev[i] = best[i].map(|h| h.0);
+                os[i] = best[i].map(|h| self.to_hit(h));
+            }
+        }
     }
 
     fn to_hit(&self, (prim, t): (u32, f32)) -> Hit {
@@ -161,13 +238,26 @@ impl BvhCaster {
 impl Caster for BvhCaster {
     fn cast(&self, ray: &Ray) -> Option<Hit> {
         let pre = RayPre::new(ray);
-        self.cast_seeded(ray, &pre, None).map(|h| self.to_hit(h))
+        self.cast_seeded(ray, &pre, None, &mut Vec::new()).map(|h| self.to_hit(h))
     }
 
     fn cast_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        let mut stack = Vec::with_capacity(64);
+        if let Tree::Four(w) = &self.tree
+            && self.options.packet_rays > 1
+        {
+            match self.options.packet_rays {
+                2..=4 => self.batch_packets::<4>(w, rays, out, &mut stack),
+                5..=8 => self.batch_packets::<8>(w, rays, out, &mut stack),
+                9..=16 => self.batch_packets::<16>(w, rays, out, &mut stack),
+                _ => self.batch_packets::<32>(w, rays, out, &mut stack),
+            }
+            return;
+        }
         if !self.options.coherent {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = self.cast(r);
+                let pre = RayPre::new(r);
+                *o = self.cast_seeded(r, &pre, None, &mut stack).map(|h| self.to_hit(h));
             }
             return;
         }
@@ -178,7 +268,7 @@ impl Caster for BvhCaster {
                 let [a, b, c] = self.tris[p as usize];
                 pre.intersect(a, b, c, r.t_max).map(|t| (p, t))
             });
-            let h = self.cast_seeded(r, &pre, seed);
+            let h = self.cast_seeded(r, &pre, seed, &mut stack);
             prev = h.map(|(p, _)| p);
             *o = h.map(|h| self.to_hit(h));
         }

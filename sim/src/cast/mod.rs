@@ -6,6 +6,7 @@ mod bvh;
 pub mod fixture;
 mod reference;
 pub mod watertight;
+mod wide4;
 
 pub use bvh::{BvhCaster, BvhLayout, BvhOptions};
 pub use reference::ParryCaster;

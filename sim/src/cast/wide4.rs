@@ -1,0 +1,521 @@
+//! A 4-wide BVH collapsed from an obvhs `Bvh2`, with a closest-hit traversal that tests the four
+//! child boxes of a node together (structure-of-arrays, so the slab tests vectorise) and visits
+//! children nearest first. Triangles are stored in the order the leaves are laid out.
+//!
+//! Collapse rule: starting from a binary node's two children, the inner child with the largest
+//! surface area is replaced by its own two children until there are four or only leaves remain.
+
+use glam::Vec3;
+use obvhs::bvh2::Bvh2;
+
+use super::watertight::RayPre;
+
+/// Marks an unused child slot.
+const EMPTY: u32 = u32::MAX;
+
+/// One node: bounds of up to four children, structure-of-arrays.
+#[derive(Clone, Copy, Debug)]
+struct Node4 {
+    /// `bounds[a][k]`: axis `a` minimum (a = 0..3) and maximum (a = 3..6) of child `k`.
+    bounds: [[f32; 4]; 6],
+    /// Inner child: node index; leaf child: first triangle (in layout order).
+    child: [u32; 4],
+    /// 0 for an inner child, the triangle count for a leaf, [`EMPTY`] for an unused slot.
+    count: [u32; 4],
+}
+
+impl Node4 {
+    fn empty() -> Self {
+        let mut bounds = [[f32::INFINITY; 4]; 6];
+        bounds[3..].iter_mut().for_each(|b| *b = [f32::NEG_INFINITY; 4]);
+        Self { bounds, child: [0; 4], count: [EMPTY; 4] }
+    }
+}
+
+/// The 4-wide BVH and its triangles in layout order.
+pub(super) struct Wide4 {
+    nodes: Vec<Node4>,
+    /// Triangle corners in layout order.
+    pub(super) tris: Vec<[Vec3; 3]>,
+    /// Layout order -> index into the mesh's triangles.
+    pub(super) order_to_triangle: Vec<u32>,
+    /// The root is a single leaf (tiny meshes): `(first, count)`.
+    root_leaf: Option<(u32, u32)>,
+}
+
+/// Per-ray traversal constants.
+struct RayBox {
+    origin: [f32; 3],
+    inv_dir: [f32; 3],
+    /// Index into `Node4::bounds` of the near plane per axis (min for a positive direction).
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl Wide4 {
+    /// Collapses `bvh2` (with `primitive_indices` into `tris_of_mesh`) into a 4-wide BVH.
+    pub(super) fn from_bvh2(bvh2: &Bvh2, tri_of: impl Fn(u32) -> [Vec3; 3]) -> Self {
+        let mut w = Self { nodes: Vec::new(), tris: Vec::new(), order_to_triangle: Vec::new(), root_leaf: None };
+        if bvh2.nodes.is_empty() {
+            return w;
+        }
+        let root = &bvh2.nodes[0];
+        if root.is_leaf() {
+            let first = w.emit_leaf(bvh2, 0, &tri_of);
+            w.root_leaf = Some((first, root.prim_count));
+            return w;
+        }
+        w.nodes.push(Node4::empty());
+        w.fill(bvh2, 0, 0, &tri_of);
+        w
+    }
+
+    fn emit_leaf(&mut self, bvh2: &Bvh2, node: usize, tri_of: &impl Fn(u32) -> [Vec3; 3]) -> u32 {
+        let n = &bvh2.nodes[node];
+        let first = self.tris.len() as u32;
+        for i in n.first_index..n.first_index + n.prim_count {
+            let prim = bvh2.primitive_indices[i as usize];
+            self.tris.push(tri_of(prim));
+            self.order_to_triangle.push(prim);
+        }
+        first
+    }
+
+    /// Fills node `slot` of `self` from the binary inner node `node`.
+    fn fill(&mut self, bvh2: &Bvh2, node: usize, slot: usize, tri_of: &impl Fn(u32) -> [Vec3; 3]) {
+        let first = bvh2.nodes[node].first_index as usize;
+        let mut kids = vec![first, first + 1];
+        while kids.len() < 4 {
+            let best = kids
+                .iter()
+                .enumerate()
+                .filter(|(_, k)| !bvh2.nodes[**k].is_leaf())
+                .max_by(|a, b| bvh2.nodes[*a.1].aabb().half_area().total_cmp(&bvh2.nodes[*b.1].aabb().half_area()));
+            let Some((i, &k)) = best else { break };
+            let f = bvh2.nodes[k].first_index as usize;
+            kids.swap_remove(i);
+            kids.push(f);
+            kids.push(f + 1);
+        }
+        for (j, &k) in kids.iter().enumerate() {
+            let n = &bvh2.nodes[k];
+            let bb = n.aabb();
+            for a in 0..3 {
+                self.nodes[slot].bounds[a][j] = bb.min[a];
+                self.nodes[slot].bounds[a + 3][j] = bb.max[a];
+            }
+            if n.is_leaf() {
+                let first = self.emit_leaf(bvh2, k, tri_of);
+                self.nodes[slot].child[j] = first;
+                self.nodes[slot].count[j] = n.prim_count;
+            } else {
+                let child = self.nodes.len();
+                self.nodes.push(Node4::empty());
+                self.nodes[slot].child[j] = child as u32;
+                self.nodes[slot].count[j] = 0;
+                self.fill(bvh2, k, child, tri_of);
+            }
+        }
+    }
+
+    /// Closest hit `(layout index, t)` of the ray prepared in `pre` against `tris` (this tree's
+    /// triangles in layout order, taken out of `self.tris` by the caller), not farther than `seed`'s `t`
+    /// (and, with a seed, strictly closer than it, so a tie keeps the seed).
+    #[inline]
+    pub(super) fn cast(
+        &self,
+        pre: &RayPre,
+        dir: Vec3,
+        tris: &[[Vec3; 3]],
+        seed: Option<(u32, f32)>,
+        stack: &mut Vec<(u32, f32)>,
+    ) -> Option<(u32, f32)> {
+        let mut best = seed;
+        let mut best_t = seed.map_or(pre.t_max, |s| s.1);
+        if let Some((first, count)) = self.root_leaf {
+            Self::leaf(tris, pre, first, count, &mut best, &mut best_t);
+            return best;
+        }
+        if self.nodes.is_empty() {
+            return best;
+        }
+        let inv_dir = [safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z)];
+        let near = |a: usize| a + usize::from(inv_dir[a] < 0.0) * 3;
+        let far = |a: usize| a + usize::from(inv_dir[a] >= 0.0) * 3;
+        let rb = RayBox {
+            origin: pre.origin.to_array(),
+            inv_dir,
+            near: [near(0), near(1), near(2)],
+            far: [far(0), far(1), far(2)],
+        };
+        stack.clear();
+        let mut node = 0u32;
+        loop {
+            let n = &self.nodes[node as usize];
+            let (t_near, hit) = slab4(n, &rb, best_t);
+            // Children met, nearest first.
+            let mut order = [(0usize, 0.0f32); 4];
+            let mut m = 0;
+            for k in 0..4 {
+                if hit[k] {
+                    let mut i = m;
+                    while i > 0 && order[i - 1].1 > t_near[k] {
+                        order[i] = order[i - 1];
+                        i -= 1;
+                    }
+                    order[i] = (k, t_near[k]);
+                    m += 1;
+                }
+            }
+            // Leaves at once (they shorten `best_t` for their siblings), inner children after.
+            let mut inner = [(0u32, 0.0f32); 4];
+            let mut q = 0;
+            for &(k, t) in &order[..m] {
+                if n.count[k] == 0 {
+                    inner[q] = (n.child[k], t);
+                    q += 1;
+                } else if t <= best_t {
+                    Self::leaf(tris, pre, n.child[k], n.count[k], &mut best, &mut best_t);
+                }
+            }
+            // Descend into the nearest inner child; push the others farthest first.
+            let mut next = None;
+            for &(c, t) in inner[..q].iter().rev() {
+                if t <= best_t {
+                    if let Some(prev) = next {
+                        stack.push(prev);
+                    }
+                    next = Some((c, t));
+                }
+            }
+            match next {
+                Some((c, _)) => node = c,
+                None => loop {
+                    match stack.pop() {
+                        Some((c, t)) if t <= best_t => {
+                            node = c;
+                            break;
+                        }
+                        Some(_) => continue,
+                        None => return best,
+                    }
+                },
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn leaf(tris: &[[Vec3; 3]], pre: &RayPre, first: u32, count: u32, best: &mut Option<(u32, f32)>, best_t: &mut f32) {
+        for i in first..first + count {
+            let [a, b, c] = tris[i as usize];
+            if let Some(t) = pre.intersect(a, b, c, *best_t)
+                && (best.is_none() || t < *best_t)
+            {
+                *best = Some((i, t));
+                *best_t = t;
+            }
+        }
+    }
+}
+
+/// `1 / d`, or +-1e30 (with the sign of `d`) where that would overflow: slab distances stay finite
+/// or infinite but never NaN (`0 * inf`) for a ray lying exactly in a box face.
+#[inline(always)]
+fn safe_inv(d: f32) -> f32 {
+    if d.abs() < 1e-30 { 1e30f32.copysign(d) } else { 1.0 / d }
+}
+
+/// Slab test of the four children: entry distances and which children the ray meets in `[0, t_max]`.
+#[inline(always)]
+fn slab4(n: &Node4, rb: &RayBox, t_max: f32) -> ([f32; 4], [bool; 4]) {
+    let mut t_near = [0.0f32; 4];
+    let mut t_far = [t_max; 4];
+    for a in 0..3 {
+        let (o, i) = (rb.origin[a], rb.inv_dir[a]);
+        let lo = &n.bounds[rb.near[a]];
+        let hi = &n.bounds[rb.far[a]];
+        for k in 0..4 {
+            t_near[k] = t_near[k].max((lo[k] - o) * i);
+            t_far[k] = t_far[k].min((hi[k] - o) * i);
+        }
+    }
+    let mut hit = [false; 4];
+    for k in 0..4 {
+        hit[k] = t_near[k] <= t_far[k];
+    }
+    (t_near, hit)
+}
+
+/// Rays per packet in [`Wide4::cast_packet`].
+pub(super) const PACKET: usize = 4;
+
+/// Slab constants of one ray for packet traversal (no per-ray near/far selection: min / max).
+#[derive(Clone, Copy)]
+struct PacketRay {
+    origin: [f32; 3],
+    inv_dir: [f32; 3],
+}
+
+impl Wide4 {
+    /// Closest hits of [`PACKET`] rays traversed together: a node is visited when any ray of the
+    /// packet meets it within that ray's closest hit so far; a leaf's triangles are tested only
+    /// against the rays that meet the leaf's box. Each ray gets the same closest hit as [`Wide4::cast`]
+    /// (up to exact ties). `best[r]` may hold a seed hit for ray `r`.
+    pub(super) fn cast_packet(
+        &self,
+        pres: &[RayPre; PACKET],
+        dirs: &[Vec3; PACKET],
+        tris: &[[Vec3; 3]],
+        best: &mut [Option<(u32, f32)>; PACKET],
+        stack: &mut Vec<(u32, f32)>,
+    ) {
+        let mut best_t = [0.0f32; PACKET];
+        for r in 0..PACKET {
+            best_t[r] = best[r].map_or(pres[r].t_max, |s| s.1);
+        }
+        if let Some((first, count)) = self.root_leaf {
+            for r in 0..PACKET {
+                Self::leaf(tris, &pres[r], first, count, &mut best[r], &mut best_t[r]);
+            }
+            return;
+        }
+        if self.nodes.is_empty() {
+            return;
+        }
+        let rays: [PacketRay; PACKET] = std::array::from_fn(|r| PacketRay {
+            origin: pres[r].origin.to_array(),
+            inv_dir: [safe_inv(dirs[r].x), safe_inv(dirs[r].y), safe_inv(dirs[r].z)],
+        });
+        stack.clear();
+        let mut node = 0u32;
+        loop {
+            let n = &self.nodes[node as usize];
+            // Per child: which rays meet it, and the smallest entry distance among them.
+            let mut mask = [0u8; 4];
+            let mut t_min = [f32::INFINITY; 4];
+            for (r, ray) in rays.iter().enumerate() {
+                let (t_near, hit) = slab4_minmax(n, ray, best_t[r]);
+                for k in 0..4 {
+                    // Unused slots (+inf..-inf boxes) pass the min / max slab test: skip them.
+                    if hit[k] && n.count[k] != EMPTY {
+                        mask[k] |= 1 << r;
+                        t_min[k] = t_min[k].min(t_near[k]);
+                    }
+                }
+            }
+            let mut order = [(0usize, 0.0f32); 4];
+            let mut m = 0;
+            for k in 0..4 {
+                if mask[k] != 0 {
+                    let mut i = m;
+                    while i > 0 && order[i - 1].1 > t_min[k] {
+                        order[i] = order[i - 1];
+                        i -= 1;
+                    }
+                    order[i] = (k, t_min[k]);
+                    m += 1;
+                }
+            }
+            let mut inner = [(0u32, 0.0f32); 4];
+            let mut q = 0;
+            for &(k, t) in &order[..m] {
+                if n.count[k] == 0 {
+                    inner[q] = (n.child[k], t);
+                    q += 1;
+                } else {
+                    for r in 0..PACKET {
+                        if mask[k] & (1 << r) != 0 {
+                            Self::leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
+                        }
+                    }
+                }
+            }
+            let far = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+            let mut next = None;
+            for &(c, t) in inner[..q].iter().rev() {
+                if t <= far {
+                    if let Some(prev) = next {
+                        stack.push(prev);
+                    }
+                    next = Some((c, t));
+                }
+            }
+            match next {
+                Some((c, _)) => node = c,
+                None => loop {
+                    let far = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+                    match stack.pop() {
+                        Some((c, t)) if t <= far => {
+                            node = c;
+                            break;
+                        }
+                        Some(_) => continue,
+                        None => return,
+                    }
+                },
+            }
+        }
+    }
+}
+
+/// Slab test of the four children against one packet ray (near / far planes by min / max).
+#[inline(always)]
+fn slab4_minmax(n: &Node4, ray: &PacketRay, t_max: f32) -> ([f32; 4], [bool; 4]) {
+    let mut t_near = [0.0f32; 4];
+    let mut t_far = [t_max; 4];
+    for a in 0..3 {
+        let (o, i) = (ray.origin[a], ray.inv_dir[a]);
+        let lo = &n.bounds[a];
+        let hi = &n.bounds[a + 3];
+        for k in 0..4 {
+            let t0 = (lo[k] - o) * i;
+            let t1 = (hi[k] - o) * i;
+            t_near[k] = t_near[k].max(t0.min(t1));
+            t_far[k] = t_far[k].min(t0.max(t1));
+        }
+    }
+    let mut hit = [false; 4];
+    for k in 0..4 {
+        hit[k] = t_near[k] <= t_far[k];
+    }
+    (t_near, hit)
+}
+
+impl Wide4 {
+    /// Closest hits of `N` rays that share one origin and whose directions have the same sign on
+    /// every axis (a small fan of LiDAR beams), or `false` without touching `best` when they do not.
+    ///
+    /// Inner nodes are tested once for the whole fan with interval arithmetic: per axis, the fan's
+    /// inverse directions span `[i_lo, i_hi]`, so a plane at signed offset `p` is reached between
+    /// `min(p i_lo, p i_hi)` and `max(p i_lo, p i_hi)`; a node is entered when
+    /// `max_axis(min entry) <= min_axis(max exit)`, a superset of "some ray meets the box". Leaves
+    /// get an exact per-ray slab test before their triangles are tested for that ray, so each ray
+    /// gets the same closest hit as [`Wide4::cast`] (up to exact ties).
+    pub(super) fn cast_fan<const N: usize>(
+        &self,
+        pres: &[RayPre; N],
+        dirs: &[Vec3; N],
+        tris: &[[Vec3; 3]],
+        best: &mut [Option<(u32, f32)>; N],
+        stack: &mut Vec<(u32, f32)>,
+    ) -> bool {
+        let origin = pres[0].origin;
+        if self.root_leaf.is_some() || self.nodes.is_empty() || pres.iter().any(|p| p.origin != origin) {
+            return false;
+        }
+        let inv: [[f32; 3]; N] =
+            std::array::from_fn(|r| [safe_inv(dirs[r].x), safe_inv(dirs[r].y), safe_inv(dirs[r].z)]);
+        let mut i_lo = [f32::INFINITY; 3];
+        let mut i_hi = [f32::NEG_INFINITY; 3];
+        for a in 0..3 {
+            let neg = inv[0][a] < 0.0;
+            for v in &inv {
+                if (v[a] < 0.0) != neg {
+                    return false;
+                }
+                i_lo[a] = i_lo[a].min(v[a]);
+                i_hi[a] = i_hi[a].max(v[a]);
+            }
+        }
+        let o = origin.to_array();
+        let near: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] < 0.0) * 3);
+        let far: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] >= 0.0) * 3);
+        let rbs: [RayBox; N] = std::array::from_fn(|r| RayBox { origin: o, inv_dir: inv[r], near, far });
+        let mut best_t = [0.0f32; N];
+        for r in 0..N {
+            best_t[r] = best[r].map_or(pres[r].t_max, |s| s.1);
+        }
+        let mut far_t = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+        stack.clear();
+        let mut node = 0u32;
+        loop {
+            let n = &self.nodes[node as usize];
+            let (t_near, hit) = slab4_fan(n, &o, &i_lo, &i_hi, &near, &far, far_t);
+            let mut order = [(0usize, 0.0f32); 4];
+            let mut m = 0;
+            for k in 0..4 {
+                if hit[k] {
+                    let mut i = m;
+                    while i > 0 && order[i - 1].1 > t_near[k] {
+                        order[i] = order[i - 1];
+                        i -= 1;
+                    }
+                    order[i] = (k, t_near[k]);
+                    m += 1;
+                }
+            }
+            let mut inner = [(0u32, 0.0f32); 4];
+            let mut q = 0;
+            let mut leaf_hits: Option<[[bool; 4]; N]> = None;
+            for &(k, t) in &order[..m] {
+                if n.count[k] == 0 {
+                    inner[q] = (n.child[k], t);
+                    q += 1;
+                } else {
+                    let per_ray =
+                        leaf_hits.get_or_insert_with(|| std::array::from_fn(|r| slab4(n, &rbs[r], best_t[r]).1));
+                    for r in 0..N {
+                        if per_ray[r][k] {
+                            Self::leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
+                        }
+                    }
+                    far_t = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+                }
+            }
+            let mut next = None;
+            for &(c, t) in inner[..q].iter().rev() {
+                if t <= far_t {
+                    if let Some(prev) = next {
+                        stack.push(prev);
+                    }
+                    next = Some((c, t));
+                }
+            }
+            match next {
+                Some((c, _)) => node = c,
+                None => loop {
+                    match stack.pop() {
+                        Some((c, t)) if t <= far_t => {
+                            node = c;
+                            break;
+                        }
+                        Some(_) => continue,
+                        None => return true,
+                    }
+                },
+            }
+        }
+    }
+}
+
+/// Interval slab test of the four children against a fan of rays from `o` whose inverse directions
+/// lie in `[i_lo, i_hi]` per axis (one sign per axis): the smallest possible entry distance and
+/// whether some ray of the fan may meet the child within `[0, t_max]`.
+#[inline(always)]
+fn slab4_fan(
+    n: &Node4,
+    o: &[f32; 3],
+    i_lo: &[f32; 3],
+    i_hi: &[f32; 3],
+    near: &[usize; 3],
+    far: &[usize; 3],
+    t_max: f32,
+) -> ([f32; 4], [bool; 4]) {
+    let mut t_near = [0.0f32; 4];
+    let mut t_far = [t_max; 4];
+    for a in 0..3 {
+        let lo = &n.bounds[near[a]];
+        let hi = &n.bounds[far[a]];
+        for k in 0..4 {
+            let p = lo[k] - o[a];
+            let q = hi[k] - o[a];
+            t_near[k] = t_near[k].max((p * i_lo[a]).min(p * i_hi[a]));
+            t_far[k] = t_far[k].min((q * i_lo[a]).max(q * i_hi[a]));
+        }
+    }
+    let mut hit = [false; 4];
+    for k in 0..4 {
+        hit[k] = t_near[k] <= t_far[k] && n.count[k] != EMPTY;
+    }
+    (t_near, hit)
+}
