@@ -1,6 +1,8 @@
 //! Prints, per grid row of plane 0 of a PCD, returns, ground truth and misses of `nitsch`
 //! (a diagnostic: `cargo run --release -p classifier --example inspect -- FILE.pcd`).
 
+#![allow(clippy::needless_range_loop)]
+
 use classifier::{Nitsch, NitschParams};
 
 fn main() {

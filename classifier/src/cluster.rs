@@ -39,6 +39,9 @@
 //!    vegetation next to the road (FPR 0.06 -> 0.15 over 5 frames), so it stays an option;
 //! 6. every other cluster is not ground (very small clusters are noise).
 
+// Parallel per-cell arrays are indexed by cell on purpose (structure of arrays).
+#![allow(clippy::needless_range_loop)]
+
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result, is_valid};

@@ -143,7 +143,10 @@ fn cell_features(
         if let Some(j) = nb[k] {
             let d = view.points[j] - p;
             let l2 = d.length_squared();
-            if l2 <= max_d2 && l2 > 0.0 && !(view.ranges[j] < keep[k] * range) {
+            if l2 <= max_d2
+                && l2 > 0.0
+                && view.ranges[j].partial_cmp(&(keep[k] * range)) != Some(std::cmp::Ordering::Less)
+            {
                 (dx[k], dy[k], dz[k], ok[k]) = (d.x, d.y, d.z, 1.0);
             }
         }

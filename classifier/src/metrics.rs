@@ -5,6 +5,9 @@
 //! Positive = ground. Only cells with a return count (no-return cells are neither). A measure whose
 //! denominator is zero is reported as NaN by the accessors (e.g. FPR of a frame with no non-ground).
 
+// Parallel per-cell arrays are indexed by cell on purpose (structure of arrays).
+#![allow(clippy::needless_range_loop)]
+
 use std::collections::BTreeMap;
 
 use serde::Serialize;
