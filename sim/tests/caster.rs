@@ -89,6 +89,7 @@ fn bvh_matches_parry_on_random_scene() {
     for options in [
         BvhOptions::default(),
         BvhOptions { coherent: false, packet_rays: 0, ..BvhOptions::default() },
+        BvhOptions { coherent: true, packet_rays: 0, ..BvhOptions::default() },
         BvhOptions { layout: BvhLayout::Binary, ..BvhOptions::default() },
         BvhOptions { layout: BvhLayout::Wide, max_prims_per_leaf: 3, ..BvhOptions::default() },
     ] {
@@ -274,8 +275,8 @@ fn bvh_fans_match_parry_on_lidar_rays() {
     let rays = lidar_rays(&[Vec3::new(0.5, 0.25, 3.0), Vec3::new(-10.0, 7.0, 1.0)], 4, 2, f32::INFINITY);
     let reference = ParryCaster::new(&mesh);
     let expected: Vec<Option<Hit>> = rays.iter().map(|r| reference.cast(r)).collect();
-    for packet_rays in [0, 4, 8, 16, 32] {
-        let bvh = BvhCaster::with_options(&mesh, BvhOptions { packet_rays, ..BvhOptions::default() });
+    for (packet_rays, coherent) in [(0, true), (4, false), (8, true), (16, false), (16, true), (32, false)] {
+        let bvh = BvhCaster::with_options(&mesh, BvhOptions { packet_rays, coherent, ..BvhOptions::default() });
         let (hits, ties) = compare(&mesh, &rays, &bvh.cast_all(&rays), &expected);
         assert!(hits > 20_000 && hits < 60_000, "packet_rays {packet_rays}: {hits} hits of {}", rays.len());
         assert!(ties < 100, "{ties} ties");
