@@ -43,7 +43,7 @@ const MAX_OBJECTS: f32 = 40_000.0;
 #[derive(Deserialize, Debug, Clone, Default)]
 #[serde(default, deny_unknown_fields)]
 pub struct Params {
-    /// Side of the square terrain, metres (50 ..= 600; sparse and moderate 240, dense 160).
+    /// Side of the square terrain, metres (50 ..= 600; sparse 240, moderate 160, dense 120).
     pub size_m: Option<f32>,
     /// Peak height of the terrain relief, metres (0 ..= 5; sparse 0.5, moderate 1.2, dense 1.5).
     pub relief_m: Option<f32>,
@@ -98,7 +98,11 @@ impl Params {
             Preset::Moderate => (1.2, 130.0, 3500.0, 800.0, (2.5, 5.0), (2.0, 3.5), (0.15, 0.35)),
             Preset::Dense => (1.5, 300.0, 6000.0, 3000.0, (2.0, 4.0), (1.2, 2.2), (0.2, 0.4)),
         };
-        let size = if preset == Preset::Dense { 120.0 } else { 240.0 };
+        let size = match preset {
+            Preset::Sparse => 240.0,
+            Preset::Moderate => 160.0,
+            Preset::Dense => 120.0,
+        };
         Resolved {
             size_m: self.size_m.unwrap_or(size),
             relief_m: self.relief_m.unwrap_or(relief),
