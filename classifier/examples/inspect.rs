@@ -30,6 +30,19 @@ fn main() {
             "missed {missed:4} in cluster {root}: size {size} inside {inside} height {h:.2} ground {dec} at {p:?}"
         );
     }
+    let mut fps = std::collections::BTreeMap::new();
+    for i in 0..cloud.rows * cloud.cols {
+        if !cloud.ground[i]
+            && g[i]
+            && let Some(root) = m.workspace.cluster_of(i)
+        {
+            *fps.entry((root, cloud.label[i].name())).or_insert(0) += 1;
+        }
+    }
+    for ((root, class), k) in fps {
+        let (size, inside, h, dec) = m.workspace.cluster_summary(root);
+        println!("false {k:4} {class} in cluster {root}: size {size} inside {inside} height {h:.2} ground {dec}");
+    }
     for r in 0..cloud.rows {
         let (mut ret, mut gt, mut tp, mut fp, mut fn_, mut cand_fn, mut gsum) = (0, 0, 0, 0, 0, 0, 0.0);
         for c in 0..cloud.cols {

@@ -5,8 +5,10 @@
 //! within a radius and a condition holds. Here the radius search uses the grid's own adjacency
 //! (the 8-neighbourhood of [`crate::neighbours`]) instead of a k-d tree: two candidates join when
 //! they are grid neighbours and their distance is at most `link_tolerance_m + link_tolerance_rel *
-//! max(|p_a|, |p_b|)` (distances from the vehicle origin; the spacing of scan points grows with
-//! range, so a fixed radius would cut far ground into rings). The condition is that both are
+//! max(|p_a|, |p_b|)` (distances from the vehicle origin). The range-proportional part defaults to
+//! 0 (a fixed 0.5 m radius, as PCL uses): the tangent-plane link below already joins far rings,
+//! and a radius growing with range joined low objects to the ground (`city`, `lux-roof-4`, 2
+//! frames: FPR 0.0095 with 0.05 per metre, 0.0060 with 0). The condition is that both are
 //! candidates (`g_rho >= threshold`). On a surface sampled by the grid, every pair of candidates
 //! within the radius is connected through a chain of grid neighbours, so the partition equals the
 //! k-d tree's (tested against a brute-force radius clustering); the two differ only across gaps of
@@ -58,7 +60,9 @@ pub struct ClusterParams {
     pub max_plane_offset_m: f32,
     /// Clusters smaller than this are noise.
     pub min_cluster_points: usize,
-    /// Clusters outside the ground area with at least this many points are ground.
+    /// Clusters outside the ground area with at least this many points are ground. (Measured on
+    /// `highway` with `hdl64e-roof`: guard-rail posts cut the terrain below the embankment into
+    /// strips of 100-350 points; 50 points / 0.1 % keeps them, F1 0.957 -> 0.976.)
     pub min_large_points: usize,
     /// ... or at least this fraction of the returns, whichever is more.
     pub min_large_fraction: f32,
@@ -74,11 +78,11 @@ impl Default for ClusterParams {
     fn default() -> Self {
         Self {
             link_tolerance_m: 0.5,
-            link_tolerance_rel: 0.05,
+            link_tolerance_rel: 0.0,
             max_plane_offset_m: 0.25,
             min_cluster_points: 5,
-            min_large_points: 100,
-            min_large_fraction: 0.005,
+            min_large_points: 50,
+            min_large_fraction: 0.001,
             area_cell_m: 2.0,
             max_step_m: 0.5,
             near_search_m: 0.0,
