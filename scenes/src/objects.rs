@@ -264,6 +264,22 @@ pub fn building(mesh: &mut SceneMesh, ids: &mut Ids, base: Vec3, yaw_rad: f32, d
     id
 }
 
+/// A curb stone run (class sidewalk, ground "stuff": instance 0) from `a` to `b` on the ground,
+/// `width_m` wide and `height_m` high: a closed box, for islands and kerbs off the terrain grid
+/// (street curbs are cut into the terrain grid instead, see the `city` family).
+pub fn curb(mesh: &mut SceneMesh, a: Vec3, b: Vec3, width_m: f32, height_m: f32) {
+    let d = b - a;
+    let len = d.truncate().length();
+    let at = pose(a, d.y.atan2(d.x));
+    let hw = 0.5 * width_m;
+    mesh.push_oriented_box(
+        at,
+        Vec3::new(0.0, -hw, -0.1),
+        Vec3::new(len, hw, height_m),
+        Surface::stuff(SemanticClass::SIDEWALK),
+    );
+}
+
 /// A table (class other-object): a 1.6 x 0.9 m top at 0.75 m on four legs.
 pub fn table(mesh: &mut SceneMesh, ids: &mut Ids, base: Vec3, yaw_rad: f32) -> u32 {
     let id = ids.fresh();

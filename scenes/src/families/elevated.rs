@@ -112,6 +112,14 @@ impl Family for Params {
             let p = Vec3::new(-8.0 + 3.0 * k as f32, -24.0 + r.random_range(-1.0..1.0f32), 0.0);
             objects::table(&mut mesh, &mut ids, p, r.random_range(0.0..1.0f32));
         }
+        // A curbed island (15 cm, ground) with a tree at the end of each parking row.
+        for y in [-6.0f32, 6.0] {
+            let (x0, x1, y0, y1) = (-62.0, -58.0, y - 2.5, y + 2.5);
+            for (a, b) in [((x0, y0), (x1, y0)), ((x1, y0), (x1, y1)), ((x1, y1), (x0, y1)), ((x0, y1), (x0, y0))] {
+                objects::curb(&mut mesh, Vec3::new(a.0, a.1, 0.0), Vec3::new(b.0, b.1, 0.0), 0.2, 0.15);
+            }
+            objects::tree(&mut mesh, &mut ids, Vec3::new(-60.0, y, 0.0), 2.5, 0.15, 1.8);
+        }
         for x in [-60.0f32, -20.0, 20.0, 60.0] {
             objects::pole(&mut mesh, &mut ids, Vec3::new(x, -50.0, 0.0), 8.0);
         }
