@@ -25,6 +25,8 @@ fn every_bundled_scene_is_valid_deterministic_and_labelled() {
     for name in scenes::bundled_names() {
         let a = scenes::load(name, 0).unwrap();
         a.mesh.validate().unwrap();
+        let degenerate = (0..a.mesh.len()).filter(|&i| a.mesh.triangle_normal(i) == glam::Vec3::ZERO).count();
+        assert_eq!(degenerate, 0, "{name}: zero-area triangles");
         let n = a.mesh.len();
         assert!((10_000..1_500_000).contains(&n), "{name}: {n} triangles");
         let ground = a.mesh.surfaces.iter().filter(|s| s.class.is_ground()).count();
