@@ -39,7 +39,12 @@ fn frame() -> OrderedCloud {
 
 fn bench_write(c: &mut Criterion) {
     let cloud = frame();
-    let dir = tempfile::tempdir().expect("temp dir");
+    // `GT_BENCH_DIR` picks where the files go (e.g. /dev/shm to leave out the disk's fsync cost).
+    let dir = match std::env::var_os("GT_BENCH_DIR") {
+        Some(base) => tempfile::tempdir_in(base),
+        None => tempfile::tempdir(),
+    }
+    .expect("temp dir");
     let ctx = FrameContext { index: 0, sensor_from_vehicle: None };
     let mut group = c.benchmark_group("write_128x2048");
     group.sample_size(20);
