@@ -33,7 +33,11 @@
 //!    car is still judged by its height where it overlaps the ground (measured on `city`);
 //! 4. a cluster outside the area is ground when it is large (at least `min_large_points` points, or
 //!    `min_large_fraction` of the plane's returns if that is more: terrain beyond a basin, another
-//!    floor);
+//!    floor), or when it spreads over at least `min_large_extent_m` (the diagonal of its x-y
+//!    bounding box) and lies no higher than `max_step_m` above the ground cluster's mean height:
+//!    far away, where rings lie metres apart, a large surface has few points (measured on
+//!    `rural`: terrain below the road), while object tops are a few metres across or stand above
+//!    the ground (rows of parked cars on `city`) (0 = off);
 //! 5. (our addition, measured on `rural`) a smaller cluster outside the area is also ground when it
 //!    lies no higher than `max_step_m` above the nearest square of the ground area within
 //!    `near_search_m` (its outside points' mean height against that square's mean): a flat
@@ -69,6 +73,8 @@ pub struct ClusterParams {
     pub min_large_points: usize,
     /// ... or at least this fraction of the returns, whichever is more.
     pub min_large_fraction: f32,
+    /// ... or spread over at least this x-y diagonal, metres (0 = off).
+    pub min_large_extent_m: f32,
     /// Side of the squares of the ground area, metres.
     pub area_cell_m: f32,
     /// Height above the local ground cluster beyond which an inside cluster is an object, metres.
@@ -86,6 +92,7 @@ impl Default for ClusterParams {
             min_cluster_points: 5,
             min_large_points: 100,
             min_large_fraction: 0.001,
+            min_large_extent_m: 10.0,
             area_cell_m: 2.0,
             max_step_m: 0.5,
             near_search_m: 0.0,
@@ -108,6 +115,9 @@ impl ClusterParams {
         }
         if !(self.min_large_fraction.is_finite() && (0.0..=1.0).contains(&self.min_large_fraction)) {
             return Err(ClassifyError::invalid("min_large_fraction", self.min_large_fraction, "0 ..= 1"));
+        }
+        if !(self.min_large_extent_m.is_finite() && self.min_large_extent_m >= 0.0) {
+            return Err(ClassifyError::invalid("min_large_extent_m", self.min_large_extent_m, "finite, >= 0"));
         }
         if !pos(self.area_cell_m) {
             return Err(ClassifyError::invalid("area_cell_m", self.area_cell_m, "finite, > 0"));
@@ -134,6 +144,8 @@ pub struct ClusterWorkspace {
     height_sum: Vec<f32>,
     /// Sum of the points outside the ground area, per root.
     outside_sum: Vec<Vec3>,
+    /// x-y bounding box per root.
+    bbox: Vec<(glam::Vec2, glam::Vec2)>,
     /// Ground-area squares: (sum z, count) per square in a bounding box.
     area: Vec<(f32, u32)>,
     /// Decision per root.
@@ -297,12 +309,16 @@ impl ClusterWorkspace {
         self.height_sum.resize(n, 0.0);
         self.outside_sum.clear();
         self.outside_sum.resize(n, Vec3::ZERO);
+        self.bbox.clear();
+        self.bbox.resize(n, (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY)));
         for i in 0..n {
             let root = self.parent[i];
             if root == NONE || root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points
             {
                 continue;
             }
+            let b = &mut self.bbox[root as usize];
+            (b.0, b.1) = (b.0.min(points[i].truncate()), b.1.max(points[i].truncate()));
             let (x, y) = square(points[i]);
             let (mut zs, mut cnt) = (0.0f32, 0u32);
             for dy in -1..=1 {
@@ -322,6 +338,8 @@ impl ClusterWorkspace {
                 self.outside_sum[root as usize] += points[i];
             }
         }
+        let (zsum, zcount) = self.area.iter().fold((0f64, 0u64), |(a, b), e| (a + f64::from(e.0), b + u64::from(e.1)));
+        let ground_mean_z = (zsum / zcount.max(1) as f64) as f32;
         let min_large = params.min_large_points.max((params.min_large_fraction * returns as f32).ceil() as usize);
         self.root_ground.clear();
         self.root_ground.resize(n, false);
@@ -337,7 +355,12 @@ impl ClusterWorkspace {
             } else if 10 * self.inside[root] as usize >= size && self.inside[root] as usize >= params.min_cluster_points
             {
                 self.height_sum[root] / (self.inside[root] as f32) <= params.max_step_m
-            } else if size >= min_large {
+            } else if size >= min_large
+                || (params.min_large_extent_m > 0.0
+                    && (self.bbox[root].1 - self.bbox[root].0).length() >= params.min_large_extent_m
+                    && self.outside_sum[root].z / (size - self.inside[root] as usize).max(1) as f32
+                        <= ground_mean_z + params.max_step_m)
+            {
                 true
             } else {
                 // Rule 5: level with or below the nearest ground-area square.
