@@ -223,3 +223,33 @@ fn grid_accumulation_uses_poses_across_frames() {
     assert!(e.pooled.recall() > 0.95, "{:?}", e.pooled);
     assert!(e.pooled.fpr() < 0.2, "{:?}", e.pooled);
 }
+
+#[test]
+fn wide_low_clusters_outside_the_ground_area_are_ground_high_ones_are_not() {
+    let (rows, cols) = (3, 200);
+    let mut pts = vec![Vec3::NAN; rows * cols];
+    for c in 0..150 {
+        pts[c] = Vec3::new(5.0, -7.5 + 0.1 * c as f32, 0.0);
+    }
+    for c in 0..20 {
+        pts[cols + c] = Vec3::new(60.0, -10.0 + c as f32, -0.5);
+        pts[2 * cols + c] = Vec3::new(60.0, -10.0 + c as f32, 3.0);
+    }
+    let ranges: Vec<f32> = pts.iter().map(|p| p.length()).collect();
+    let view =
+        classifier::neighbours::GridView { points: &pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
+    let candidate: Vec<bool> = pts.iter().map(|p| p.is_finite()).collect();
+    let normals = vec![Vec3::Z; pts.len()];
+    let returns = candidate.iter().filter(|&&c| c).count();
+    for (extent, low_expected) in [(10.0, true), (0.0, false)] {
+        let params = ClusterParams { min_large_extent_m: extent, ..Default::default() };
+        let mut ws = ClusterWorkspace::default();
+        cluster_candidates(&view, &candidate, &normals, &params, &mut ws);
+        assert_eq!(ws.cluster_count(), 3);
+        let mut ground = vec![false; pts.len()];
+        ws.decide(&pts, returns, &params, &mut ground);
+        assert!(ground[..150].iter().all(|&g| g), "the largest cluster is ground");
+        assert!(ground[cols..cols + 20].iter().all(|&g| g == low_expected), "low strip, extent {extent}");
+        assert!(ground[2 * cols..2 * cols + 20].iter().all(|&g| !g), "raised strip, extent {extent}");
+    }
+}
