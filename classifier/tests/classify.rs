@@ -228,8 +228,8 @@ fn grid_accumulation_uses_poses_across_frames() {
 fn wide_low_clusters_outside_the_ground_area_are_ground_high_ones_are_not() {
     let (rows, cols) = (3, 200);
     let mut pts = vec![Vec3::NAN; rows * cols];
-    for c in 0..150 {
-        pts[c] = Vec3::new(5.0, -7.5 + 0.1 * c as f32, 0.0);
+    for (c, p) in pts[..150].iter_mut().enumerate() {
+        *p = Vec3::new(5.0, -7.5 + 0.1 * c as f32, 0.0);
     }
     for c in 0..20 {
         pts[cols + c] = Vec3::new(60.0, -10.0 + c as f32, -0.5);
