@@ -215,7 +215,43 @@ fn pcd_header_that_disagrees_with_data_is_refused() {
     let text =
         String::from_utf8_lossy(&pcd::encode(&cloud, true).unwrap()).replace("DATA ascii", "DATA binary_compressed");
     let m = bad_file_message(pcd::read_bytes(path, text.as_bytes()).unwrap_err(), path);
-    assert!(m.contains("binary_compressed"), "{m}");
+    assert!(m.contains("binary_compressed") && m.contains("uncompressed size"), "{m}");
+}
+
+/// PCL's `binary_compressed`: our binary records made field-major and LZF-coded (literal runs
+/// only, which is valid LZF) read back as the same grid.
+#[test]
+fn pcd_binary_compressed_reads_back() {
+    let cloud = synthetic(3, 9, 1);
+    let bin = pcd::encode(&cloud, false).unwrap();
+    let data_at = bin.windows(12).position(|w| w == b"DATA binary\n").unwrap() + 12;
+    let (header, records) = bin.split_at(data_at);
+    let sizes = [4usize, 4, 4, 4, 2, 8, 4, 4, 1, 4, 1, 1, 4, 4, 4, 4];
+    let rec = sizes.iter().sum::<usize>();
+    assert_eq!(rec, pcd::RECORD_BYTES);
+    let n = records.len() / rec;
+    let mut fields = Vec::new();
+    let mut offset = 0;
+    for s in sizes {
+        for i in 0..n {
+            fields.extend_from_slice(&records[i * rec + offset..i * rec + offset + s]);
+        }
+        offset += s;
+    }
+    let mut lzf = Vec::new();
+    for chunk in fields.chunks(32) {
+        lzf.push((chunk.len() - 1) as u8);
+        lzf.extend_from_slice(chunk);
+    }
+    let mut file = String::from_utf8_lossy(header).replace("DATA binary", "DATA binary_compressed").into_bytes();
+    file.extend_from_slice(&(lzf.len() as u32).to_le_bytes());
+    file.extend_from_slice(&(fields.len() as u32).to_le_bytes());
+    file.extend_from_slice(&lzf);
+    let back = pcd::read_bytes(Path::new("c.pcd"), &file).unwrap();
+    assert_same_grid(&cloud, &back);
+    let m =
+        bad_file_message(pcd::read_bytes(Path::new("c.pcd"), &file[..file.len() - 3]).unwrap_err(), Path::new("c.pcd"));
+    assert!(m.contains("compressed size"), "{m}");
 }
 
 #[test]

@@ -11,6 +11,7 @@ pub mod atomic;
 pub mod formats;
 pub mod kitti;
 pub mod las;
+mod lzf;
 pub mod manifest;
 pub mod pcd;
 pub mod ply;

@@ -8,7 +8,7 @@
 //! `normal_x normal_y normal_z` (F4). A comment line `# groundtruth rows=R planes=P` lets our
 //! reader restore multi-echo grids; other tools ignore it.
 //!
-//! The reader accepts `ascii` and `binary` data (`binary_compressed` is refused with a message),
+//! The reader accepts `ascii`, `binary` and `binary_compressed` (LZF, field-major) data,
 //! any field order, types F/I/U of sizes 1/2/4/8 and COUNT > 1 (only the first element is read).
 //! Organized files (`HEIGHT > 1`) become a `HEIGHT x WIDTH` grid, unorganized ones a `1 x N` grid.
 //! Fields the file lacks get defaults: ring = row, column = column, sensor 0, time 0, label 0,
@@ -208,6 +208,8 @@ struct FieldPos {
 enum DataKind {
     Ascii,
     Binary,
+    /// LZF-compressed, field-major (PCL's `binary_compressed`).
+    Compressed,
 }
 
 struct Header {
@@ -221,6 +223,8 @@ struct Header {
     data_start: usize,
     /// `(rows, planes)` from our comment line.
     grid: Option<(usize, usize)>,
+    /// `(byte offset, byte width)` of every field within a record, in file order.
+    field_spans: Vec<(usize, usize)>,
 }
 
 fn parse_usize(path: &Path, key: &str, v: Option<&&str>) -> Result<usize> {
@@ -290,13 +294,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                 data = Some(match rest.first().map(|s| s.to_ascii_lowercase()) {
                     Some(s) if s == "ascii" => DataKind::Ascii,
                     Some(s) if s == "binary" => DataKind::Binary,
-                    Some(s) if s == "binary_compressed" => {
-                        return Err(bad(
-                            "PCD DATA binary_compressed is not supported; convert with `pcl_convert_pcd_ascii_binary \
-                             IN OUT 1` (binary)"
-                                .into(),
-                        ));
-                    }
+                    Some(s) if s == "binary_compressed" => DataKind::Compressed,
                     other => return Err(bad(format!("PCD header: unknown DATA `{}`", other.unwrap_or_default()))),
                 })
             }
@@ -326,6 +324,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
     let data = data.ok_or_else(|| bad("PCD header: no DATA".into()))?;
     let mut slots = [None; SLOTS];
     let (mut offset, mut token) = (0usize, 0usize);
+    let mut field_spans = Vec::with_capacity(fields.len());
     for k in 0..fields.len() {
         let scalar = match (types[k], sizes[k]) {
             ('F', 4 | 8) => Scalar::F(sizes[k]),
@@ -336,6 +335,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
         if let Some(slot) = slot_of(&fields[k]) {
             slots[slot as usize].get_or_insert(FieldPos { scalar, offset, token });
         }
+        field_spans.push((offset, sizes[k] * counts[k]));
         offset += sizes[k] * counts[k];
         token += counts[k];
     }
@@ -344,18 +344,70 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             return Err(bad(format!("PCD header: no `{name}` field")));
         }
     }
-    Ok(Header { slots, width, height, points, record_bytes: offset, tokens: token, data, data_start, grid })
+    Ok(Header {
+        slots,
+        width,
+        height,
+        points,
+        record_bytes: offset,
+        tokens: token,
+        data,
+        data_start,
+        grid,
+        field_spans,
+    })
+}
+
+/// Decompresses PCL's `binary_compressed` data (u32 compressed size, u32 uncompressed size, LZF
+/// data holding each field's values for all points in turn) into point-major records.
+fn decompress_fields(path: &Path, h: &Header, data: &[u8]) -> Result<Vec<u8>> {
+    let bad = |m: String| SimError::bad_file(path, format!("PCD binary_compressed: {m}"));
+    let word = |k: usize| data.get(k..k + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    let (Some(packed), Some(unpacked)) = (word(0), word(4)) else {
+        return Err(bad("data shorter than its 8-byte size prefix".into()));
+    };
+    let need = h.points.checked_mul(h.record_bytes).ok_or_else(|| bad("data size overflows".into()))?;
+    if unpacked != need {
+        return Err(bad(format!(
+            "uncompressed size {unpacked} but {} points of {} bytes need {need}",
+            h.points, h.record_bytes
+        )));
+    }
+    let lzf = data.get(8..8 + packed).ok_or_else(|| {
+        bad(format!("compressed size {packed} but the file holds {} bytes after the prefix", data.len() - 8))
+    })?;
+    // LZF expands at most ~132 times (a 2-byte back-reference of up to 264 bytes).
+    if unpacked > lzf.len().saturating_mul(140) + 64 {
+        return Err(bad(format!("{packed} compressed bytes cannot expand to {unpacked}")));
+    }
+    let fields = super::lzf::decompress(lzf, unpacked).map_err(bad)?;
+    // Field-major -> point-major: field k (`width` bytes per point) starts at `points * offset_k`.
+    let mut out = vec![0u8; need];
+    for (offset, width) in &h.field_spans {
+        let src = &fields[h.points * offset..h.points * (offset + width)];
+        for (i, chunk) in src.chunks_exact(*width).enumerate() {
+            out[i * h.record_bytes + offset..i * h.record_bytes + offset + width].copy_from_slice(chunk);
+        }
+    }
+    Ok(out)
 }
 
 /// Parses PCD `bytes` (read from `path`, named in errors) into an ordered cloud.
 pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
     let h = parse_header(path, bytes)?;
     let bad = |m: String| SimError::bad_file(path, m);
-    let body = &bytes[h.data_start..];
+    let decompressed;
+    let body = match h.data {
+        DataKind::Compressed => {
+            decompressed = decompress_fields(path, &h, &bytes[h.data_start..])?;
+            &decompressed[..]
+        }
+        _ => &bytes[h.data_start..],
+    };
     // Check the declared size against the data before allocating anything of that size.
     let mut ascii_lines: Vec<&[u8]> = Vec::new();
     match h.data {
-        DataKind::Binary => {
+        DataKind::Binary | DataKind::Compressed => {
             let need = h.points.checked_mul(h.record_bytes).ok_or_else(|| bad("PCD: data size overflows".into()))?;
             if body.len() != need {
                 return Err(bad(format!(
@@ -390,7 +442,7 @@ pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
     let mut tokens: Vec<&str> = Vec::with_capacity(h.tokens);
     for i in 0..h.points {
         match h.data {
-            DataKind::Binary => {
+            DataKind::Binary | DataKind::Compressed => {
                 let rec = &body[i * h.record_bytes..(i + 1) * h.record_bytes];
                 for (v, pos) in vals.iter_mut().zip(h.slots.iter()) {
                     *v = pos.and_then(|p| p.scalar.decode(&rec[p.offset..], false)).unwrap_or(f64::NAN);
