@@ -19,7 +19,9 @@
 //! So grid neighbours also join when each lies within `max_plane_offset_m` of the other's tangent
 //! plane (`|n_a . (p_b - p_a)|` and `|n_b . (p_a - p_b)|`): far rings of one flat surface join,
 //! a roof 1.5 m above the ground behind it does not, however far apart they are. This link exists
-//! only between grid neighbours (0 switches it off, which gives the pure radius clustering).
+//! only between grid neighbours (0 switches it off, which gives the pure radius clustering). The
+//! default offset is 0.15 m, the paper's 15 cm ground tolerance (0.25 m joined low vegetation to
+//! the terrain: `rural`, `lux-roof-4`, 5 frames, FPR 0.109 -> 0.071 with 0.15 m).
 //!
 //! Rules (Sec. III-B), in order:
 //! 1. clusters with fewer than `min_cluster_points` points are noise: not ground;
@@ -88,7 +90,7 @@ impl Default for ClusterParams {
         Self {
             link_tolerance_m: 0.5,
             link_tolerance_rel: 0.0,
-            max_plane_offset_m: 0.25,
+            max_plane_offset_m: 0.15,
             min_cluster_points: 5,
             min_large_points: 100,
             min_large_fraction: 0.001,
