@@ -9,11 +9,12 @@
 //!   slab test can never cull a node whose triangle the ray touches exactly on the box boundary
 //!   (flat ground gives zero-thickness boxes): the BVH is as watertight as the triangle test.
 //! - [`Caster::cast_batch`] exploits LiDAR coherence: consecutive rays of a batch are neighbours on
-//!   the sensor grid (same origin, azimuths a fraction of a degree apart), so groups of
+//!   the sensor grid (one origin or nearly, azimuths a fraction of a degree apart), so groups of
 //!   [`BvhOptions::packet_rays`] rays are traversed together as a fan: one interval slab test per
 //!   node for the whole group instead of one per ray, exact per-ray tests at the leaves (measured:
-//!   about 1.7x the one-ray-at-a-time speed on the fixture). Groups that do not share an origin fall
-//!   back to 4-ray packets. Optionally ([`BvhOptions::coherent`], off by default: measured no gain)
+//!   about 1.7x the one-ray-at-a-time speed on the fixture). The origins of a fan may differ
+//!   (per-laser offsets): the interval test covers them. Groups whose directions straddle an axis
+//!   are cast one ray at a time. Optionally ([`BvhOptions::coherent`], off by default: measured no gain)
 //!   the triangle the previous ray hit is tested first to seed a short `t_max`.
 //! - Every ray gets the same closest hit as [`Caster::cast`] (ties between triangles at exactly the
 //!   same distance may pick the other triangle; a tie is not a leak), and the grouping depends only
@@ -30,7 +31,7 @@ use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use obvhs::ray::{Ray as ORay, RayHit};
 
 use super::watertight::RayPre;
-use super::wide4::{PACKET, Wide4};
+use super::wide4::Wide4;
 use super::{Caster, Hit, Ray};
 use crate::scene::SceneMesh;
 
@@ -56,8 +57,9 @@ pub struct BvhOptions {
     /// same lane in the previous fan) to start with a short `t_max`.
     pub coherent: bool,
     /// Traverse groups of this many consecutive rays together in [`Caster::cast_batch`] (layout
-    /// [`BvhLayout::Four`] only; 4, 8, 16 or 32; 0 or 1: one ray at a time). A group that shares one
-    /// origin and one direction octant is traversed as a fan (interval slab tests, see `wide4.rs`).
+    /// [`BvhLayout::Four`] only; 4, 8, 16 or 32; 0 or 1: one ray at a time). A group whose
+    /// directions share one octant is traversed as a fan (interval slab tests, see `wide4.rs`);
+    /// other groups one ray at a time.
     pub packet_rays: usize,
     /// Largest number of triangles per leaf (binary: 1..=255, wide: 1..=3).
     pub max_prims_per_leaf: u32,
@@ -223,12 +225,9 @@ impl BvhCaster {
                 }
             }
             if !w.cast_fan(&pres, &dirs, &self.tris, &mut best, stack) {
-                for (q, (p4, d4)) in pres.chunks_exact(PACKET).zip(dirs.chunks_exact(PACKET)).enumerate() {
-                    let p4: &[RayPre; PACKET] = p4.try_into().expect("chunks_exact gives PACKET rays");
-                    let d4: &[Vec3; PACKET] = d4.try_into().expect("chunks_exact gives PACKET rays");
-                    let mut b4: [Option<(u32, f32)>; PACKET] = std::array::from_fn(|i| best[q * PACKET + i]);
-                    w.cast_packet(p4, d4, &self.tris, &mut b4, stack);
-                    best[q * PACKET..(q + 1) * PACKET].copy_from_slice(&b4);
+                // Mixed direction signs (the fan straddles an axis): one ray at a time.
+                for i in 0..N {
+                    best[i] = w.cast(&pres[i], dirs[i], &self.tris, best[i], stack);
                 }
             }
             for i in 0..N {

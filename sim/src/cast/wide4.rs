@@ -246,151 +246,18 @@ fn slab4(n: &Node4, rb: &RayBox, t_max: f32) -> ([f32; 4], [bool; 4]) {
     (t_near, hit)
 }
 
-/// Rays per packet in [`Wide4::cast_packet`].
-pub(super) const PACKET: usize = 4;
-
-/// Slab constants of one ray for packet traversal (no per-ray near/far selection: min / max).
-#[derive(Clone, Copy)]
-struct PacketRay {
-    origin: [f32; 3],
-    inv_dir: [f32; 3],
-}
-
 impl Wide4 {
-    /// Closest hits of [`PACKET`] rays traversed together: a node is visited when any ray of the
-    /// packet meets it within that ray's closest hit so far; a leaf's triangles are tested only
-    /// against the rays that meet the leaf's box. Each ray gets the same closest hit as [`Wide4::cast`]
-    /// (up to exact ties). `best[r]` may hold a seed hit for ray `r`.
-    pub(super) fn cast_packet(
-        &self,
-        pres: &[RayPre; PACKET],
-        dirs: &[Vec3; PACKET],
-        tris: &[[Vec3; 3]],
-        best: &mut [Option<(u32, f32)>; PACKET],
-        stack: &mut Vec<(u32, f32)>,
-    ) {
-        let mut best_t = [0.0f32; PACKET];
-        for r in 0..PACKET {
-            best_t[r] = best[r].map_or(pres[r].t_max, |s| s.1);
-        }
-        if let Some((first, count)) = self.root_leaf {
-            for r in 0..PACKET {
-                Self::leaf(tris, &pres[r], first, count, &mut best[r], &mut best_t[r]);
-            }
-            return;
-        }
-        if self.nodes.is_empty() {
-            return;
-        }
-        let rays: [PacketRay; PACKET] = std::array::from_fn(|r| PacketRay {
-            origin: pres[r].origin.to_array(),
-            inv_dir: [safe_inv(dirs[r].x), safe_inv(dirs[r].y), safe_inv(dirs[r].z)],
-        });
-        stack.clear();
-        let mut node = 0u32;
-        loop {
-            let n = &self.nodes[node as usize];
-            // Per child: which rays meet it, and the smallest entry distance among them.
-            let mut mask = [0u8; 4];
-            let mut t_min = [f32::INFINITY; 4];
-            for (r, ray) in rays.iter().enumerate() {
-                let (t_near, hit) = slab4_minmax(n, ray, best_t[r]);
-                for k in 0..4 {
-                    // Unused slots (+inf..-inf boxes) pass the min / max slab test: skip them.
-                    if hit[k] && n.count[k] != EMPTY {
-                        mask[k] |= 1 << r;
-                        t_min[k] = t_min[k].min(t_near[k]);
-                    }
-                }
-            }
-            let mut order = [(0usize, 0.0f32); 4];
-            let mut m = 0;
-            for k in 0..4 {
-                if mask[k] != 0 {
-                    let mut i = m;
-                    while i > 0 && order[i - 1].1 > t_min[k] {
-                        order[i] = order[i - 1];
-                        i -= 1;
-                    }
-                    order[i] = (k, t_min[k]);
-                    m += 1;
-                }
-            }
-            let mut inner = [(0u32, 0.0f32); 4];
-            let mut q = 0;
-            for &(k, t) in &order[..m] {
-                if n.count[k] == 0 {
-                    inner[q] = (n.child[k], t);
-                    q += 1;
-                } else {
-                    for r in 0..PACKET {
-                        if mask[k] & (1 << r) != 0 {
-                            Self::leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
-                        }
-                    }
-                }
-            }
-            let far = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
-            let mut next = None;
-            for &(c, t) in inner[..q].iter().rev() {
-                if t <= far {
-                    if let Some(prev) = next {
-                        stack.push(prev);
-                    }
-                    next = Some((c, t));
-                }
-            }
-            match next {
-                Some((c, _)) => node = c,
-                None => loop {
-                    let far = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
-                    match stack.pop() {
-                        Some((c, t)) if t <= far => {
-                            node = c;
-                            break;
-                        }
-                        Some(_) => continue,
-                        None => return,
-                    }
-                },
-            }
-        }
-    }
-}
-
-/// Slab test of the four children against one packet ray (near / far planes by min / max).
-#[inline(always)]
-fn slab4_minmax(n: &Node4, ray: &PacketRay, t_max: f32) -> ([f32; 4], [bool; 4]) {
-    let mut t_near = [0.0f32; 4];
-    let mut t_far = [t_max; 4];
-    for a in 0..3 {
-        let (o, i) = (ray.origin[a], ray.inv_dir[a]);
-        let lo = &n.bounds[a];
-        let hi = &n.bounds[a + 3];
-        for k in 0..4 {
-            let t0 = (lo[k] - o) * i;
-            let t1 = (hi[k] - o) * i;
-            t_near[k] = t_near[k].max(t0.min(t1));
-            t_far[k] = t_far[k].min(t0.max(t1));
-        }
-    }
-    let mut hit = [false; 4];
-    for k in 0..4 {
-        hit[k] = t_near[k] <= t_far[k];
-    }
-    (t_near, hit)
-}
-
-impl Wide4 {
-    /// Closest hits of `N` rays that share one origin and whose directions have the same sign on
-    /// every axis (a small fan of LiDAR beams), or `false` without touching `best` when they do not.
+    /// Closest hits of `N` rays whose directions have the same sign on every axis (a small fan of
+    /// LiDAR beams), or `false` without touching `best` when they do not.
     ///
     /// Inner nodes are tested once for the whole fan with interval arithmetic: per axis, the fan's
-    /// inverse directions span `[i_lo, i_hi]`, so a plane at signed offset `p` is reached between
-    /// `min(p i_lo, p i_hi)` and `max(p i_lo, p i_hi)`; a node is entered when
-    /// `max_axis(min entry) <= min_axis(max exit)`, a superset of "some ray meets the box". Leaves
-    /// get an exact per-ray slab test before their triangles are tested for that ray, so each ray
-    /// gets the same closest hit as [`Wide4::cast`] (up to exact ties).
+    /// origins span `[o_lo, o_hi]` (one point for most sensors, a few centimetres for per-laser
+    /// offsets) and its inverse directions `[i_lo, i_hi]`, so the plane `b` is reached between the
+    /// smallest and the largest of the four products `(b - o) i` at the interval corners (the product
+    /// is bilinear); a node is entered when `max_axis(min entry) <= min_axis(max exit)`, a superset of
+    /// "some ray meets the box". Leaves get an exact per-ray slab test before their triangles are
+    /// tested for that ray, so each ray gets the same closest hit as [`Wide4::cast`] (up to exact
+    /// ties).
     pub(super) fn cast_fan<const N: usize>(
         &self,
         pres: &[RayPre; N],
@@ -399,10 +266,25 @@ impl Wide4 {
         best: &mut [Option<(u32, f32)>; N],
         stack: &mut Vec<(u32, f32)>,
     ) -> bool {
-        let origin = pres[0].origin;
-        if self.root_leaf.is_some() || self.nodes.is_empty() || pres.iter().any(|p| p.origin != origin) {
+        if self.root_leaf.is_some() || self.nodes.is_empty() {
             return false;
         }
+        if pres.iter().all(|p| p.origin == pres[0].origin) {
+            self.cast_fan_impl::<N, true>(pres, dirs, tris, best, stack)
+        } else {
+            self.cast_fan_impl::<N, false>(pres, dirs, tris, best, stack)
+        }
+    }
+
+    /// [`Wide4::cast_fan`] for one shared origin (`ONE_ORIGIN`) or an origin interval.
+    fn cast_fan_impl<const N: usize, const ONE_ORIGIN: bool>(
+        &self,
+        pres: &[RayPre; N],
+        dirs: &[Vec3; N],
+        tris: &[[Vec3; 3]],
+        best: &mut [Option<(u32, f32)>; N],
+        stack: &mut Vec<(u32, f32)>,
+    ) -> bool {
         let inv: [[f32; 3]; N] =
             std::array::from_fn(|r| [safe_inv(dirs[r].x), safe_inv(dirs[r].y), safe_inv(dirs[r].z)]);
         let mut i_lo = [f32::INFINITY; 3];
@@ -417,10 +299,13 @@ impl Wide4 {
                 i_hi[a] = i_hi[a].max(v[a]);
             }
         }
-        let o = origin.to_array();
+        let o_lo = pres.iter().fold(Vec3::INFINITY, |m, p| m.min(p.origin)).to_array();
+        let o_hi = pres.iter().fold(Vec3::NEG_INFINITY, |m, p| m.max(p.origin)).to_array();
+        let fan = Fan { o_lo, o_hi, i_lo, i_hi };
         let near: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] < 0.0) * 3);
         let far: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] >= 0.0) * 3);
-        let rbs: [RayBox; N] = std::array::from_fn(|r| RayBox { origin: o, inv_dir: inv[r], near, far });
+        let rbs: [RayBox; N] =
+            std::array::from_fn(|r| RayBox { origin: pres[r].origin.to_array(), inv_dir: inv[r], near, far });
         let mut best_t = [0.0f32; N];
         for r in 0..N {
             best_t[r] = best[r].map_or(pres[r].t_max, |s| s.1);
@@ -430,7 +315,7 @@ impl Wide4 {
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let (t_near, hit) = slab4_fan(n, &o, &i_lo, &i_hi, &near, &far, far_t);
+            let (t_near, hit) = slab4_fan::<ONE_ORIGIN>(n, &fan, &near, &far, far_t);
             let mut order = [(0usize, 0.0f32); 4];
             let mut m = 0;
             for k in 0..4 {
@@ -488,15 +373,21 @@ impl Wide4 {
     }
 }
 
-/// Interval slab test of the four children against a fan of rays from `o` whose inverse directions
-/// lie in `[i_lo, i_hi]` per axis (one sign per axis): the smallest possible entry distance and
-/// whether some ray of the fan may meet the child within `[0, t_max]`.
+/// The extent of a fan of rays: origins and inverse directions per axis.
+struct Fan {
+    o_lo: [f32; 3],
+    o_hi: [f32; 3],
+    i_lo: [f32; 3],
+    i_hi: [f32; 3],
+}
+
+/// Interval slab test of the four children against a fan of rays (one direction sign per axis):
+/// the smallest possible entry distance and whether some ray of the fan may meet the child within
+/// `[0, t_max]`. `ONE_ORIGIN`: all rays start at `o_lo` (two products per plane instead of four).
 #[inline(always)]
-fn slab4_fan(
+fn slab4_fan<const ONE_ORIGIN: bool>(
     n: &Node4,
-    o: &[f32; 3],
-    i_lo: &[f32; 3],
-    i_hi: &[f32; 3],
+    fan: &Fan,
     near: &[usize; 3],
     far: &[usize; 3],
     t_max: f32,
@@ -506,11 +397,23 @@ fn slab4_fan(
     for a in 0..3 {
         let lo = &n.bounds[near[a]];
         let hi = &n.bounds[far[a]];
-        for k in 0..4 {
-            let p = lo[k] - o[a];
-            let q = hi[k] - o[a];
-            t_near[k] = t_near[k].max((p * i_lo[a]).min(p * i_hi[a]));
-            t_far[k] = t_far[k].min((q * i_lo[a]).max(q * i_hi[a]));
+        let (o_lo, o_hi, i_lo, i_hi) = (fan.o_lo[a], fan.o_hi[a], fan.i_lo[a], fan.i_hi[a]);
+        if ONE_ORIGIN {
+            for k in 0..4 {
+                let (p, q) = (lo[k] - o_lo, hi[k] - o_lo);
+                t_near[k] = t_near[k].max((p * i_lo).min(p * i_hi));
+                t_far[k] = t_far[k].min((q * i_lo).max(q * i_hi));
+            }
+        } else {
+            for k in 0..4 {
+                // (b - o) * i is bilinear in (o, i): its extremes are at the corners.
+                let (p0, p1) = (lo[k] - o_hi, lo[k] - o_lo);
+                let entry = (p0 * i_lo).min(p0 * i_hi).min((p1 * i_lo).min(p1 * i_hi));
+                let (q0, q1) = (hi[k] - o_hi, hi[k] - o_lo);
+                let exit = (q0 * i_lo).max(q0 * i_hi).max((q1 * i_lo).max(q1 * i_hi));
+                t_near[k] = t_near[k].max(entry);
+                t_far[k] = t_far[k].min(exit);
+            }
         }
     }
     let mut hit = [false; 4];
