@@ -91,6 +91,7 @@ pub fn read_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<SceneMesh> {
     mesh.vertices.reserve(nv);
     mesh.triangles.reserve(fel.count);
     mesh.surfaces.reserve(fel.count);
+    let mut idx: Vec<u32> = Vec::with_capacity(8);
     plyfile::walk(path, bytes, &header, |e, row, s, list| {
         if e == ve {
             let p = Vec3::new(s[ix] as f32, s[iy] as f32, s[iz] as f32);
@@ -105,7 +106,7 @@ pub fn read_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<SceneMesh> {
                     format!("PLY face {row} has {} vertices (needs >= 3)", list.len()),
                 ));
             }
-            let mut idx = Vec::with_capacity(list.len());
+            idx.clear();
             for &v in list {
                 if !(v >= 0.0 && v < nv as f64) || v.fract() != 0.0 {
                     return Err(SimError::bad_file(path, format!("PLY face {row} indexes vertex {v}, file has {nv}")));
