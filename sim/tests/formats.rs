@@ -200,6 +200,10 @@ fn write_frame_lists_every_file_with_counts() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 5, "no temp files left");
     let e = sim::io::formats::Formats::parse("pcd,xyz").unwrap_err().to_string();
     assert!(e.contains("xyz") && e.contains("pcd, pcd-ascii, ply, kitti, las"), "{e}");
+    if !cfg!(feature = "laz") {
+        let e = sim::io::formats::Formats::parse("laz").unwrap_err().to_string();
+        assert!(e.contains("--features sim/laz"), "{e}");
+    }
 }
 
 #[test]
@@ -313,4 +317,21 @@ fn scene_mesh_round_trip_and_foreign_ascii_quads() {
     let p = Path::new("q.ply");
     let msg = bad_file_message(sim::scene::ply::read_mesh_bytes(p, bad.as_bytes()).unwrap_err(), p);
     assert!(msg.contains("vertex 9"), "{msg}");
+}
+
+/// LAZ holds the same points as LAS (only with `--features laz`).
+#[cfg(feature = "laz")]
+#[test]
+fn laz_reads_back_with_the_same_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let cloud = synthetic(8, 30, 1);
+    let path = dir.path().join("a.laz");
+    let n = las_io::write_with(&path, &cloud, true).unwrap();
+    let mut reader = las::Reader::from_path(&path).unwrap();
+    let points: Vec<las::Point> = reader.read_all().unwrap().points().map(|p| p.unwrap()).collect();
+    assert_eq!(points.len(), n);
+    let class2 = points.iter().filter(|p| p.classification == las::point::Classification::Ground).count();
+    assert_eq!(class2, cloud.ground_returns());
+    let plain = las_io::encode(&path, &cloud).unwrap().0;
+    assert!(std::fs::metadata(&path).unwrap().len() < plain.len() as u64, "compressed is smaller");
 }

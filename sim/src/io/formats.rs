@@ -3,7 +3,7 @@
 //! each file atomically, and lists the files written with their point counts.
 //!
 //! File names per frame `k` (stem `frame_{k:06}`): `.pcd`, `.ply`, `.bin` + `.label` (+
-//! `.calib.txt` when the KITTI points are in the sensor frame), `.las`. The formats are encoded
+//! `.calib.txt` when the KITTI points are in the sensor frame), `.las`, `.laz`. The formats are encoded
 //! in parallel (rayon); the bytes do not depend on the thread count.
 
 use std::path::Path;
@@ -27,11 +27,13 @@ pub struct Formats {
     pub kitti: bool,
     /// LAS 1.4.
     pub las: bool,
+    /// LAZ (compressed LAS 1.4, same content; needs the `laz` cargo feature).
+    pub laz: bool,
 }
 
 impl Formats {
     /// The names [`Formats::parse`] accepts.
-    pub const NAMES: [&'static str; 5] = ["pcd", "pcd-ascii", "ply", "kitti", "las"];
+    pub const NAMES: [&'static str; 6] = ["pcd", "pcd-ascii", "ply", "kitti", "las", "laz"];
 
     /// Parses a comma-separated list such as `pcd,ply,kitti,las` (`pcd-ascii` = PCD in ASCII).
     /// Unknown names are refused with the list of allowed ones; an empty list is refused.
@@ -47,10 +49,18 @@ impl Formats {
                 "ply" => f.ply = true,
                 "kitti" => f.kitti = true,
                 "las" => f.las = true,
+                "laz" if cfg!(feature = "laz") => f.laz = true,
+                "laz" => {
+                    return Err(SimError::invalid(
+                        "format",
+                        "laz",
+                        "pcd, pcd-ascii, ply, kitti, las (this build has no LAZ: build with `--features sim/laz`)",
+                    ));
+                }
                 _ => return Err(SimError::invalid("format", name, Self::NAMES.join(", "))),
             }
         }
-        if !(f.pcd || f.ply || f.kitti || f.las) {
+        if !(f.pcd || f.ply || f.kitti || f.las || f.laz) {
             return Err(SimError::invalid(
                 "format",
                 format!("`{list}`"),
@@ -66,7 +76,7 @@ impl Formats {
 pub struct WrittenFile {
     /// File name relative to the output directory.
     pub file: String,
-    /// Format name (`pcd`, `ply`, `kitti-bin`, `kitti-label`, `kitti-calib`, `las`).
+    /// Format name (`pcd`, `ply`, `kitti-bin`, `kitti-label`, `kitti-calib`, `las`, `laz`).
     pub format: String,
     /// Number of points in the file (0 for the calibration file).
     pub points: usize,
@@ -132,14 +142,20 @@ fn write_kitti(dir: &Path, stem: &str, cloud: &OrderedCloud, ctx: &FrameContext)
     Ok(files)
 }
 
-fn write_las(dir: &Path, stem: &str, cloud: &OrderedCloud) -> Result<Vec<WrittenFile>> {
-    let name = format!("{stem}.las");
-    let n = super::las::write(&dir.join(&name), cloud)?;
-    Ok(vec![written(name, "las", n)])
+fn write_las(dir: &Path, stem: &str, cloud: &OrderedCloud, formats: &Formats) -> Result<Vec<WrittenFile>> {
+    let mut files = Vec::new();
+    for (on, ext, compressed) in [(formats.las, "las", false), (formats.laz, "laz", true)] {
+        if on {
+            let name = format!("{stem}.{ext}");
+            let n = super::las::write_with(&dir.join(&name), cloud, compressed)?;
+            files.push(written(name, ext, n));
+        }
+    }
+    Ok(files)
 }
 
 /// Writes the frame in every requested format into `dir`, atomically, and lists the files written
-/// (in the order PCD, PLY, KITTI `.bin`, `.label`, calibration, LAS).
+/// (in the order PCD, PLY, KITTI `.bin`, `.label`, calibration, LAS, LAZ).
 pub fn write_frame(
     dir: &Path,
     cloud: &OrderedCloud,
@@ -159,7 +175,7 @@ pub fn write_frame(
         || {
             rayon::join(
                 || if formats.kitti { write_kitti(dir, &stem, cloud, ctx) } else { none() },
-                || if formats.las { write_las(dir, &stem, cloud) } else { none() },
+                || if formats.las || formats.laz { write_las(dir, &stem, cloud, formats) } else { none() },
             )
         },
     );

@@ -1,4 +1,5 @@
-//! LAS 1.4 writer (point data format 6, via the `las` crate) for a frame's returns.
+//! LAS 1.4 writer (point data format 6, via the `las` crate) for a frame's returns; LAZ
+//! (compressed, same content) when the crate is built with the `laz` feature.
 //!
 //! Per point, in grid order (returns only):
 //! - `x y z`: vehicle frame, metres, stored with scale 0.0001 m and offset 0;
@@ -75,10 +76,17 @@ fn las_err(path: &Path, e: las::Error) -> SimError {
 /// Encodes the returns of `cloud` as LAS 1.4 bytes; returns the bytes and the point count.
 /// `path` only names the file in errors.
 pub fn encode(path: &Path, cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
+    encode_with(path, cloud, false)
+}
+
+/// Encodes as LAS, or as LAZ when `compressed` (needs the `laz` cargo feature; without it the
+/// las crate refuses with an error naming the missing feature).
+pub fn encode_with(path: &Path, cloud: &OrderedCloud, compressed: bool) -> Result<(Vec<u8>, usize)> {
     cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
     let mut builder = Builder::from((1, 4));
     builder.point_format = Format::new(6).map_err(|e| las_err(path, e))?;
     builder.point_format.extra_bytes = 4;
+    builder.point_format.is_compressed = compressed;
     builder.generating_software = "groundtruth".into();
     builder.system_identifier = "groundtruth LiDAR simulator".into();
     let t = Transform { scale: SCALE_M, offset: 0.0 };
@@ -131,7 +139,12 @@ pub fn encode(path: &Path, cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
 
 /// Writes the returns of `cloud` as LAS 1.4 at `path` (atomically); returns the point count.
 pub fn write(path: &Path, cloud: &OrderedCloud) -> Result<usize> {
-    let (bytes, n) = encode(path, cloud)?;
+    write_with(path, cloud, false)
+}
+
+/// Writes LAS, or LAZ when `compressed` (see [`encode_with`]); returns the point count.
+pub fn write_with(path: &Path, cloud: &OrderedCloud, compressed: bool) -> Result<usize> {
+    let (bytes, n) = encode_with(path, cloud, compressed)?;
     super::atomic::write_bytes_atomic(path, &bytes)?;
     Ok(n)
 }
