@@ -11,6 +11,8 @@ pub enum Command {
     Classify(super::bench_classify::Args),
     /// Ray casting speed (rays per second) of a caster backend on a scene or mesh.
     Raycast(bench_raycast::Args),
+    /// Cost of a full frame (casting, effects, labels, ordered cloud) against bare ray casting.
+    Scan(super::bench_scan::Args),
 }
 
 /// Runs `groundtruth bench`.
@@ -18,5 +20,6 @@ pub fn run(c: Command) -> anyhow::Result<()> {
     match c {
         Command::Classify(a) => super::bench_classify::run(a),
         Command::Raycast(a) => bench_raycast::run(a),
+        Command::Scan(a) => super::bench_scan::run(a),
     }
 }

@@ -11,6 +11,9 @@ pub struct LoadedScene {
     pub ego_ground_z_m: f32,
 }
 
+/// Name of the 1.3 M-triangle benchmark terrain (`sim::cast::fixture`), accepted wherever a scene is.
+pub const FIXTURE_TERRAIN: &str = "fixture-terrain";
+
 /// Every scene name this build knows: the simulator's built-ins and the bundled library.
 pub fn scene_names() -> Vec<String> {
     let mut names: Vec<String> = sim::scene::builtin::NAMES.iter().map(|s| s.to_string()).collect();
@@ -24,6 +27,9 @@ pub fn scene_names() -> Vec<String> {
 
 /// Loads a scene by bundled name, built-in name, or TOML file path, generated with `seed`.
 pub fn load_scene_full(name_or_file: &str, seed: u64) -> anyhow::Result<LoadedScene> {
+    if name_or_file == FIXTURE_TERRAIN {
+        return Ok(LoadedScene { mesh: sim::cast::fixture::terrain_scene(), ego_ground_z_m: 0.0 });
+    }
     let is_builtin = sim::scene::builtin::NAMES.contains(&name_or_file);
     let is_bundled = scenes::bundled_names().contains(&name_or_file);
     if is_builtin && !is_bundled {

@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_classify;
+mod bench_scan;
 mod classify;
 mod common;
 mod eval;

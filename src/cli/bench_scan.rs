@@ -1,0 +1,85 @@
+//! `groundtruth bench scan`: what a full frame (rays, casting, effects, labels, ordered cloud) costs
+//! against casting the same rays bare. Prints one JSON object.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use sim::cast::Hit;
+use sim::scan::{ScanConfig, Scanner};
+
+/// Arguments of `groundtruth bench scan`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene name or TOML file.
+    #[arg(long, default_value = "flat-objects")]
+    pub scene: String,
+    /// Rig preset or TOML file.
+    #[arg(long, default_value = "os1-128-roof")]
+    pub rig: String,
+    /// Frames to time (each timed both ways; the fastest run counts).
+    #[arg(long, default_value_t = 5)]
+    pub frames: usize,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Scene seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+/// Runs the benchmark.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if !(1..=1000).contains(&args.frames) {
+        anyhow::bail!("invalid value for `--frames`: {} (allowed: 1 ..= 1000)", args.frames);
+    }
+    let threads = args.threads;
+    let json = super::scan::with_threads(threads, || bench(&args))??;
+    println!("{json}");
+    Ok(())
+}
+
+fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
+    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
+    let rig = super::common::load_rig(&args.rig)?;
+    let t0 = Instant::now();
+    let config = ScanConfig { ego_z_m: scene.ego_ground_z_m, ..ScanConfig::default() };
+    let scanner = Scanner::new(&scene.mesh, &rig, config)?;
+    let setup_s = t0.elapsed().as_secs_f64();
+
+    let rows = scanner.rows();
+    let all_rays: Vec<_> = (0..rows).map(|r| scanner.row_rays(0, r).rays).collect();
+    let rays: usize = all_rays.iter().map(Vec::len).sum();
+    let (mut bare_s, mut full_s) = (f64::INFINITY, f64::INFINITY);
+    let mut returns = 0;
+    for _ in 0..args.frames {
+        let t = Instant::now();
+        let hits: usize = all_rays
+            .par_iter()
+            .map(|r| {
+                let mut out: Vec<Option<Hit>> = vec![None; r.len()];
+                scanner.caster().cast_batch(r, &mut out);
+                out.iter().filter(|h| h.is_some()).count()
+            })
+            .sum();
+        bare_s = bare_s.min(t.elapsed().as_secs_f64());
+        std::hint::black_box(hits);
+        let t = Instant::now();
+        let frame = scanner.frame(0);
+        full_s = full_s.min(t.elapsed().as_secs_f64());
+        returns = frame.cloud.returns();
+    }
+    Ok(serde_json::json!({
+        "bench": "scan",
+        "scene": args.scene,
+        "rig": args.rig,
+        "triangles": scene.mesh.len(),
+        "threads": rayon::current_num_threads(),
+        "rays": rays,
+        "returns": returns,
+        "setup_s": setup_s,
+        "bare_cast_ms": bare_s * 1e3,
+        "full_frame_ms": full_s * 1e3,
+        "overhead": full_s / bare_s - 1.0,
+        "rays_per_s_full": rays as f64 / full_s,
+    }))
+}
