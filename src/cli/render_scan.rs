@@ -2,7 +2,8 @@
 //! scan, coloured by class, ground truth, range or height, written as PNG.
 //!
 //! The frame's PCD is found through `DIR/manifest.json` (`frames[N].file`); without a manifest,
-//! `DIR/frame_NNNNNN.pcd` is used, and `--input FILE.pcd` draws that file.
+//! `DIR/frame_NNNNNN.pcd` is used. `--input FILE` draws that file: `.pcd`, `.ply` (a point
+//! cloud) or a KITTI `.bin` (with the `.label` beside it when there is one).
 
 use std::path::{Path, PathBuf};
 
@@ -58,6 +59,19 @@ fn frame_file(input: &Path, frame: usize) -> anyhow::Result<PathBuf> {
     }
 }
 
+/// Reads a PCD, PLY or KITTI `.bin` (with the `.label` beside it, if any) by file extension.
+fn read_cloud(file: &Path) -> anyhow::Result<sim::OrderedCloud> {
+    let ext = file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    Ok(match ext.as_deref() {
+        Some("ply") => sim::io::ply::read(file)?,
+        Some("bin") => {
+            let label = file.with_extension("label");
+            sim::io::kitti::read(file, label.is_file().then_some(label.as_path()))?
+        }
+        _ => sim::io::pcd::read(file)?,
+    })
+}
+
 /// Draws the picture.
 pub fn run(args: &super::render::Args) -> anyhow::Result<()> {
     let input = args.input.as_deref().context("render of a scan needs --input DIR|FILE.pcd")?;
@@ -67,7 +81,7 @@ pub fn run(args: &super::render::Args) -> anyhow::Result<()> {
         anyhow::bail!("--out {}: the picture is PNG, give a .png file name", args.out.display());
     }
     let file = frame_file(input, args.frame)?;
-    let cloud = sim::io::pcd::read(&file)?;
+    let cloud = read_cloud(&file)?;
     let img = match view {
         View::Bev => picture::render_bev(&cloud, &coloring, &BevOptions::default())?,
         View::Range => picture::render_range(&cloud, &coloring, &RangeOptions::default())?,
