@@ -13,12 +13,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::cli::common::FIXTURE_TERRAIN;
 use anyhow::{Context, bail};
 use glam::Vec3;
 use sim::cast::{Backend, Ray, fixture};
 
-/// Scene name of the benchmark fixture terrain.
-const FIXTURE_SCENE: &str = "fixture-terrain";
 /// Rig name of the benchmark fixture LiDAR.
 const FIXTURE_RIG: &str = "fixture-128x2048";
 /// Bytes per record of a ray file.
@@ -82,10 +81,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         bail!("invalid value for `--max-range-m`: {r} (allowed: finite, > 0)");
     }
     let (mesh, ego_ground_z_m, geometry) = match (&a.scene, &a.mesh) {
-        (Some(s), _) if s == FIXTURE_SCENE => (fixture::terrain_scene(), 0.0, s.clone()),
         (Some(s), _) => {
             let l = crate::cli::common::load_scene_full(s, a.seed)
-                .with_context(|| format!("scene `{s}` (the benchmark also knows `{FIXTURE_SCENE}`)"))?;
+                .with_context(|| format!("scene `{s}` (the benchmark also knows `{FIXTURE_TERRAIN}`)"))?;
             (l.mesh, l.ego_ground_z_m, s.clone())
         }
         (None, Some(p)) => (sim::scene::ply::read_mesh(p)?, 0.0, p.display().to_string()),
