@@ -45,26 +45,35 @@ pub struct OrderedCloud {
     pub normal: Vec<Vec3>,
 }
 
+/// A vector of `n` copies of `value`, written by the rayon pool.
+fn filled<T: Clone + Send + Sync>(value: T, n: usize) -> Vec<T> {
+    use rayon::prelude::*;
+    let mut v = Vec::with_capacity(n);
+    v.par_extend(rayon::iter::repeat_n(value, n));
+    v
+}
+
 impl OrderedCloud {
-    /// A grid of `planes * rows * cols` no-return cells (sensor `u8::MAX`, time 0).
+    /// A grid of `planes * rows * cols` no-return cells (sensor `u8::MAX`, time 0). The fields are
+    /// filled in parallel (a 128 x 2048 grid is 14 MB).
     pub fn empty(rows: usize, cols: usize, planes: usize) -> Self {
         let n = rows * cols * planes;
         Self {
             rows,
             cols,
             planes,
-            point_in_vehicle: vec![Vec3::NAN; n],
-            range_m: vec![f32::NAN; n],
-            intensity: vec![0.0; n],
-            ring: vec![0; n],
-            column: vec![0; n],
-            sensor: vec![u8::MAX; n],
-            time_s: vec![0.0; n],
-            echo: vec![0; n],
-            label: vec![SemanticClass::UNLABELED; n],
-            instance: vec![0; n],
-            ground: vec![false; n],
-            normal: vec![Vec3::ZERO; n],
+            point_in_vehicle: filled(Vec3::NAN, n),
+            range_m: filled(f32::NAN, n),
+            intensity: filled(0.0, n),
+            ring: filled(0, n),
+            column: filled(0, n),
+            sensor: filled(u8::MAX, n),
+            time_s: filled(0.0, n),
+            echo: filled(0, n),
+            label: filled(SemanticClass::UNLABELED, n),
+            instance: filled(0, n),
+            ground: filled(false, n),
+            normal: filled(Vec3::ZERO, n),
         }
     }
 

@@ -6,7 +6,6 @@
 //! with `rho` the surface reflectivity, `theta` the incidence angle and `r_ref` the sensor's
 //! `intensity_reference_m` (targets nearer than `r_ref` saturate the range term).
 
-use crate::noise::{BeamKey, Purpose};
 use crate::sensor::Measurement;
 
 /// A measured return.
@@ -25,12 +24,13 @@ pub fn cast_limit_m(m: &Measurement) -> f32 {
 
 /// Turns a true hit (distance `true_range_m`, cosine of the incidence angle `cos_incidence`, surface
 /// `reflectivity`) into a measured return, or `None` when the sensor would report nothing.
+/// `standard_normal` is the beam's standard normal draw (see [`crate::noise`]).
 pub fn measure(
     m: &Measurement,
     true_range_m: f32,
     cos_incidence: f32,
     reflectivity: f32,
-    key: &BeamKey,
+    standard_normal: f32,
 ) -> Option<Measured> {
     let cos_incidence = cos_incidence.clamp(0.0, 1.0);
     if m.max_incidence_deg < 90.0 && cos_incidence < m.max_incidence_deg.to_radians().cos() {
@@ -38,7 +38,7 @@ pub fn measure(
     }
     let mut range_m = true_range_m;
     if m.range_sigma_m > 0.0 {
-        range_m += m.range_sigma_m * key.normal(Purpose::RangeNoise);
+        range_m += m.range_sigma_m * standard_normal;
     }
     if m.range_quantum_m > 0.0 {
         range_m = (range_m / m.range_quantum_m).round() * m.range_quantum_m;
@@ -69,26 +69,27 @@ mod tests {
         }
     }
 
-    fn key(c: u32) -> BeamKey {
-        BeamKey { seed: 1, frame: 0, sensor: 0, ring: 0, column: c }
+    fn key(c: u32) -> f32 {
+        crate::noise::BeamKey { seed: 1, frame: 0, sensor: 0, ring: 0, column: c }
+            .normal(crate::noise::Purpose::RangeNoise)
     }
 
     #[test]
     fn ideal_is_exact_and_gated() {
         let m = lidar().ideal();
-        let r = measure(&m, 12.345_678, 1.0, 0.5, &key(0)).unwrap();
+        let r = measure(&m, 12.345_678, 1.0, 0.5, key(0)).unwrap();
         assert_eq!(r.range_m, 12.345_678);
         assert!((r.intensity - 0.5 * (10.0f32 / 12.345_678).powi(2)).abs() < 1e-6);
-        assert!(measure(&m, 0.4, 1.0, 0.5, &key(0)).is_none(), "below min range");
-        assert!(measure(&m, 100.5, 1.0, 0.5, &key(0)).is_none(), "beyond max range");
-        assert!(measure(&m, 10.0, 0.01, 0.5, &key(0)).is_some(), "ideal keeps grazing returns");
+        assert!(measure(&m, 0.4, 1.0, 0.5, key(0)).is_none(), "below min range");
+        assert!(measure(&m, 100.5, 1.0, 0.5, key(0)).is_none(), "beyond max range");
+        assert!(measure(&m, 10.0, 0.01, 0.5, key(0)).is_some(), "ideal keeps grazing returns");
     }
 
     #[test]
     fn noise_has_the_sigma_and_quantisation_the_step() {
         let m = lidar();
         let ranges: Vec<f32> =
-            (0..5000).filter_map(|c| measure(&m, 20.0, 1.0, 0.5, &key(c))).map(|r| r.range_m).collect();
+            (0..5000).filter_map(|c| measure(&m, 20.0, 1.0, 0.5, key(c))).map(|r| r.range_m).collect();
         assert_eq!(ranges.len(), 5000);
         for r in &ranges {
             let steps = r / 0.01;
@@ -105,7 +106,7 @@ mod tests {
     #[test]
     fn grazing_returns_drop_beyond_the_limit() {
         let m = lidar();
-        assert!(measure(&m, 10.0, 86f32.to_radians().cos(), 0.5, &key(0)).is_none());
-        assert!(measure(&m, 10.0, 84f32.to_radians().cos(), 0.5, &key(0)).is_some());
+        assert!(measure(&m, 10.0, 86f32.to_radians().cos(), 0.5, key(0)).is_none());
+        assert!(measure(&m, 10.0, 84f32.to_radians().cos(), 0.5, key(0)).is_some());
     }
 }

@@ -11,6 +11,7 @@ pub mod cloud;
 pub mod effects;
 pub mod error;
 pub mod io;
+pub mod layout;
 pub mod motion;
 pub mod noise;
 pub mod picture;

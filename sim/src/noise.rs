@@ -1,7 +1,8 @@
 //! Counter-based random streams: every random number of a scan is drawn from a generator keyed by
 //! (seed, frame, sensor, ring, column, purpose), so results never depend on thread count or order.
 
-use rand::{Rng, SeedableRng};
+use rand::{RngExt, SeedableRng};
+use rand_distr::StandardNormal;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// What a random draw is for (keeps the streams of different effects independent).
@@ -31,6 +32,32 @@ pub struct BeamKey {
     pub column: u32,
 }
 
+/// The key of one sensor row's stream: the noise of column `c` is the `c`-th draw of the stream of
+/// (seed, frame, sensor, ring), drawn for every column whether it returns or not, so a value depends
+/// on its (seed, frame, sensor, ring, column) alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RowKey {
+    /// The run's seed.
+    pub seed: u64,
+    /// Frame index.
+    pub frame: u32,
+    /// Sensor index in the rig.
+    pub sensor: u32,
+    /// Sensor ring.
+    pub ring: u32,
+}
+
+impl RowKey {
+    /// `columns` standard normal draws of this row for `purpose`, one per column.
+    pub fn normals(&self, purpose: Purpose, columns: usize) -> Vec<f32> {
+        // Column u32::MAX never occurs in a grid, so row streams never collide with beam streams.
+        let mut rng =
+            BeamKey { seed: self.seed, frame: self.frame, sensor: self.sensor, ring: self.ring, column: u32::MAX }
+                .rng(purpose);
+        (0..columns).map(|_| rng.sample(StandardNormal)).collect()
+    }
+}
+
 /// SplitMix64 finaliser: a bijective 64-bit mix.
 fn mix(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -48,19 +75,10 @@ impl BeamKey {
         Xoshiro256PlusPlus::seed_from_u64(h)
     }
 
-    /// One standard normal draw for this beam and purpose (Box-Muller).
+    /// One standard normal draw for this beam and purpose (ziggurat, `rand_distr::StandardNormal`).
     pub fn normal(&self, purpose: Purpose) -> f32 {
-        let mut rng = self.rng(purpose);
-        standard_normal(&mut rng)
+        self.rng(purpose).sample(StandardNormal)
     }
-}
-
-/// A standard normal variate by the Box-Muller transform.
-pub fn standard_normal(rng: &mut impl Rng) -> f32 {
-    let u1 = (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-    let u2 = (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-    let r = (-2.0 * (1.0 - u1).ln()).sqrt();
-    (r * (std::f64::consts::TAU * u2).cos()) as f32
 }
 
 #[cfg(test)]
@@ -76,6 +94,17 @@ mod tests {
         assert_eq!(key(5).normal(Purpose::RangeNoise), key(5).normal(Purpose::RangeNoise));
         assert_ne!(key(5).normal(Purpose::RangeNoise), key(6).normal(Purpose::RangeNoise));
         assert_ne!(key(5).normal(Purpose::RangeNoise), key(5).normal(Purpose::Dropout));
+    }
+
+    #[test]
+    fn row_draws_are_fixed_per_column_and_have_unit_variance() {
+        let row = RowKey { seed: 7, frame: 1, sensor: 0, ring: 3 };
+        let a = row.normals(Purpose::RangeNoise, 20_000);
+        assert_eq!(&row.normals(Purpose::RangeNoise, 10)[..], &a[..10], "a prefix does not depend on the length");
+        assert_ne!(RowKey { ring: 4, ..row }.normals(Purpose::RangeNoise, 10), a[..10]);
+        let mean = a.iter().map(|&x| f64::from(x)).sum::<f64>() / a.len() as f64;
+        let var = a.iter().map(|&x| (f64::from(x) - mean).powi(2)).sum::<f64>() / a.len() as f64;
+        assert!(mean.abs() < 0.03 && (var - 1.0).abs() < 0.05, "mean {mean} var {var}");
     }
 
     #[test]

@@ -17,7 +17,7 @@ use crate::effects::{cast_limit_m, measure};
 use crate::error::{Result, SimError, check_range};
 use crate::layout::RigLayout;
 use crate::motion::{PoseTrack, Trajectory, VehiclePose};
-use crate::noise::BeamKey;
+use crate::noise::{BeamKey, Purpose, RowKey};
 use crate::rig::Rig;
 use crate::scene::{SceneMesh, SemanticClass};
 use crate::sensor::{Firing, Measurement, ScanPattern};
@@ -270,6 +270,8 @@ impl<'a> Scanner<'a> {
 
         let mut extra = Vec::new();
         let mut echoes: Vec<(f32, Hit, u32)> = Vec::with_capacity(3);
+        let row_key = RowKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32 };
+        let noise = if m.range_sigma_m > 0.0 { row_key.normals(Purpose::RangeNoise, pattern.cols) } else { Vec::new() };
         for (b, &(c, f, world_from_sensor)) in beams.iter().enumerate() {
             let mc = self.layout.col_of[s][c];
             let key = BeamKey {
@@ -299,17 +301,23 @@ impl<'a> Scanner<'a> {
                     n_world = -n_world;
                 }
                 let cos_inc = -n_world.dot(centre.dir);
-                let Some(meas) = measure(m, hit.t, cos_inc, surface.reflectivity, &key) else { continue };
+                // First echoes use the row stream; later echoes (rare) their own keyed stream.
+                let z = match (echo, noise.get(c)) {
+                    (0, Some(&z)) => z,
+                    (0, None) => 0.0,
+                    _ => BeamKey { column: c as u32 | (u32::from(echo) << 24), ..key }.normal(Purpose::RangeNoise),
+                };
+                let Some(meas) = measure(m, hit.t, cos_inc, surface.reflectivity, z) else { continue };
                 let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * meas.range_m;
-                // World rotation at the shot time = world_from_sensor * sensor_from_vehicle.
-                let vehicle_from_world = vehicle_from_sensor * world_from_sensor.inverse();
+                // Rotations are orthonormal: sensor_from_world = transpose(world_from_sensor).
+                let normal_in_sensor = world_from_sensor.matrix3.transpose() * glam::Vec3A::from(n_world);
                 let cell = Cell {
                     point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
                     range_m: meas.range_m,
                     intensity: meas.intensity * count as f32 / sub_rays as f32,
                     class: surface.class,
                     instance: surface.instance,
-                    normal: vehicle_from_world.transform_vector3(n_world).normalize_or_zero(),
+                    normal: Vec3::from(vehicle_from_sensor.matrix3 * normal_in_sensor).normalize_or_zero(),
                     sensor: s as u8,
                     ring: ring as u16,
                     column: c as u32,
