@@ -7,8 +7,8 @@
 //! beyond the table's lowest or highest beam are dropped. Its azimuth `atan2(y, x)` picks the
 //! column: column 0 is centred on `azimuth_left_rad` and azimuth decreases by `azimuth_step_rad`
 //! per column (the `sim::OrderedCloud` convention), wrapping for a full turn. When two points fall
-//! into one cell the one closer to the cell's azimuth centre stays and the other is dropped
-//! (counted). Per-laser origin offsets (HDL-64E) are ignored: they shift elevations by far less
+//! into one cell the one closer to the cell's azimuth centre stays and the other moves to the
+//! adjacent column on its side if that cell stays free, else it is dropped (counted). Per-laser origin offsets (HDL-64E) are ignored: they shift elevations by far less
 //! than the beam gap beyond a few metres.
 
 use glam::{Affine3A, Vec3};
@@ -116,6 +116,8 @@ pub fn order_points(
         }
     }
     let mut owner: Vec<Option<(u32, f32)>> = vec![None; rows * cols];
+    let mut owner_alt: Vec<Option<usize>> = vec![None; rows * cols];
+    let mut losers: Vec<(u32, Option<usize>)> = Vec::new();
     let mut report = OrderingReport { cell_of_point: vec![None; points_in_sensor.len()], ..OrderingReport::default() };
     for (k, &p) in points_in_sensor.iter().enumerate() {
         let h = (p.x * p.x + p.y * p.y).sqrt();
@@ -162,22 +164,44 @@ pub fn order_points(
         }
         let off = (steps - col).abs().min((steps - col - cols as f32).abs());
         let cell = row * cols + col as usize;
+        // The adjacent column on the point's side, for a second pass.
+        let alt = if steps >= col { col as isize + 1 } else { col as isize - 1 };
+        let alt = if table.full_turn {
+            Some(alt.rem_euclid(cols as isize) as usize)
+        } else {
+            usize::try_from(alt).ok().filter(|&a| a < cols)
+        };
+        let alt_cell = alt.map(|a| row * cols + a);
         match owner[cell] {
             Some((prev, prev_off)) if prev_off <= off => {
                 let _ = prev;
-                report.collisions += 1;
+                losers.push((k as u32, alt_cell));
                 continue;
             }
             Some((prev, _)) => {
                 report.cell_of_point[prev as usize] = None;
-                report.collisions += 1;
                 report.placed -= 1;
+                losers.push((prev, owner_alt[cell]));
             }
             None => {}
         }
         owner[cell] = Some((k as u32, off));
+        owner_alt[cell] = alt_cell;
         report.cell_of_point[k] = Some(cell as u32);
         report.placed += 1;
+    }
+    // Second pass: a point that lost its cell moves to the adjacent column on its side if that is
+    // free (staggered firing times and per-laser azimuth offsets put two points into one column
+    // now and then); otherwise it is dropped as a collision.
+    for (k, alt_cell) in losers {
+        match alt_cell {
+            Some(c) if owner[c].is_none() => {
+                owner[c] = Some((k, 1.0));
+                report.cell_of_point[k as usize] = Some(c as u32);
+                report.placed += 1;
+            }
+            _ => report.collisions += 1,
+        }
     }
     for (cell, o) in owner.iter().enumerate() {
         if let Some((k, _)) = *o {

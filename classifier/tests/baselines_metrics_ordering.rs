@@ -80,3 +80,17 @@ fn ordering_recovers_the_grid_of_an_hdl64e_like_cloud() {
     // A bad table is refused.
     assert!(order_points(&points, None, &BeamTable::spinning(vec![0.1], 10), Affine3A::IDENTITY).is_err());
 }
+
+#[test]
+fn a_point_that_loses_its_cell_moves_to_the_free_adjacent_column() {
+    // 4 columns over a full turn (90 degrees each), 2 beams at 0 and 10 degrees elevation.
+    let table = BeamTable::spinning(vec![0.0, 10f32.to_radians()], 4);
+    // Column 0 is centred at 135 degrees; 130, 100 and 135 degrees all round to column 0.
+    let at = |az_deg: f32| Vec3::new(az_deg.to_radians().cos(), az_deg.to_radians().sin(), 0.0) * 10.0;
+    let pts = [at(130.0), at(100.0), at(135.0)];
+    let (_, report) = order_points(&pts, None, &table, Affine3A::IDENTITY).unwrap();
+    // 135 is best centred in column 0. The losers move in input order: 100 takes column 1 (its
+    // side), 130, evicted later, finds column 1 taken and is dropped.
+    assert_eq!(report.cell_of_point, vec![None, Some(1), Some(0)]);
+    assert_eq!((report.placed, report.collisions), (2, 1));
+}

@@ -130,6 +130,16 @@ fn read_frame(path: &Path, rig: Option<&str>) -> anyhow::Result<(OrderedCloud, O
             let labels = label.is_file().then_some(flat.label.as_slice());
             let (cloud, report) = order_points(&flat.point_in_vehicle, labels, &table, vehicle_from_sensor)
                 .with_context(|| format!("ordering `{}`", path.display()))?;
+            println!(
+                "{}: ordered {} of {} points into {} x {} ({} cell collisions, {} outside the beam table)",
+                path.display(),
+                report.placed,
+                report.cell_of_point.len(),
+                cloud.rows,
+                cloud.cols,
+                report.collisions,
+                report.outside
+            );
             Ok((cloud, Some(report.cell_of_point)))
         }
         _ => bail!("`{}`: unsupported file type (expected .pcd or .bin)", path.display()),
