@@ -77,6 +77,22 @@ impl OrderedCloud {
         }
     }
 
+    /// Sets cells `range` back to no-return cells (as [`OrderedCloud::empty`] makes them).
+    pub fn reset_cells(&mut self, range: std::ops::Range<usize>) {
+        self.point_in_vehicle[range.clone()].fill(Vec3::NAN);
+        self.range_m[range.clone()].fill(f32::NAN);
+        self.intensity[range.clone()].fill(0.0);
+        self.ring[range.clone()].fill(0);
+        self.column[range.clone()].fill(0);
+        self.sensor[range.clone()].fill(u8::MAX);
+        self.time_s[range.clone()].fill(0.0);
+        self.echo[range.clone()].fill(0);
+        self.label[range.clone()].fill(SemanticClass::UNLABELED);
+        self.instance[range.clone()].fill(0);
+        self.ground[range.clone()].fill(false);
+        self.normal[range].fill(Vec3::ZERO);
+    }
+
     /// Number of cells (`planes * rows * cols`).
     pub fn len(&self) -> usize {
         self.point_in_vehicle.len()

@@ -1,5 +1,7 @@
 //! Atomic file output: write to a temporary name beside the target, then rename, so a failed run
-//! never leaves a half-written file.
+//! never leaves a half-written file. Files are not fsync'ed (a process failure cannot leave a
+//! partial file; durability across a power cut is left to the file system, as PCL and laspy do):
+//! syncing every file cost more than the writing itself (about 40 MB per 128 x 2048 frame in all formats).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -21,7 +23,7 @@ pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::R
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
         fill(&mut w)?;
         w.flush()?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        drop(w.into_inner().map_err(|e| e.into_error())?);
         std::fs::rename(&tmp, path)
     })();
     result.map_err(|e| {
