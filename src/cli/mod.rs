@@ -5,6 +5,7 @@ mod bench_classify;
 mod bench_scan;
 mod classify;
 mod common;
+mod demo;
 mod eval;
 mod list;
 mod render;
@@ -25,6 +26,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// The main job on a built-in default: scan, classify, score and draw (city, hdl64e-roof, nitsch).
+    Demo(demo::Args),
     /// List the scenes, rigs and classification methods this build knows.
     List(list::Args),
     /// Scan a scene with a rig and write ordered labelled clouds and a manifest.
@@ -46,6 +49,7 @@ enum Command {
 /// Runs the parsed command.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Demo(a) => demo::run(a),
         Command::List(a) => list::run(a),
         Command::Scan(a) => scan::run(a),
         Command::Scene(c) => scene::run(c),

@@ -124,3 +124,23 @@ pub fn matrix_rows(a: &glam::Affine3A) -> [[f32; 4]; 4] {
     let m = glam::Mat4::from(*a).transpose();
     m.to_cols_array_2d()
 }
+
+/// The affine transform of a 4x4 row-major matrix written by [`matrix_rows`].
+pub fn affine_from_rows(rows: &[[f32; 4]; 4]) -> glam::Affine3A {
+    glam::Affine3A::from_mat4(glam::Mat4::from_cols_array_2d(rows).transpose())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matrix_rows_round_trip_and_put_translation_in_the_last_column() {
+        let a =
+            glam::Affine3A::from_rotation_translation(glam::Quat::from_rotation_z(0.3), glam::Vec3::new(1.0, 2.0, 3.0));
+        let rows = matrix_rows(&a);
+        assert_eq!([rows[0][3], rows[1][3], rows[2][3]], [1.0, 2.0, 3.0]);
+        assert_eq!(rows[3], [0.0, 0.0, 0.0, 1.0]);
+        assert!(affine_from_rows(&rows).abs_diff_eq(a, 1e-6));
+    }
+}

@@ -1,0 +1,118 @@
+//! `groundtruth demo`: the main job on a built-in default. Scans a scene with a rig (files in every
+//! format), reads the clouds back, classifies ground with a method, scores it against the ground
+//! truth and draws the pictures a user looks at first.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use classifier::{Evaluation, FrameInput, method_by_name};
+use sim::io::manifest::affine_from_rows;
+use sim::picture::{BevOptions, Coloring, render_bev, save_png};
+
+/// Arguments of `groundtruth demo`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Output directory.
+    #[arg(long, default_value = "out/demo")]
+    pub out: PathBuf,
+    /// Scene name or TOML file.
+    #[arg(long, default_value = "city")]
+    pub scene: String,
+    /// Rig preset or TOML file.
+    #[arg(long, default_value = "hdl64e-roof")]
+    pub rig: String,
+    /// Classification method (see `groundtruth list`).
+    #[arg(long, default_value = "nitsch")]
+    pub method: String,
+    /// Frames to scan.
+    #[arg(long, default_value_t = 3)]
+    pub frames: usize,
+    /// Ego speed, metres per second.
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    pub speed: f32,
+    /// Seed of the scene and the noise.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+/// Runs the demo.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let mut method = method_by_name(&args.method, args.seed)?;
+    let scan_dir = args.out.join("scan");
+    let class_dir = args.out.join("classified");
+    let scan_args = super::scan::Args {
+        scene: args.scene.clone(),
+        rig: args.rig.clone(),
+        out: scan_dir.clone(),
+        seed: args.seed,
+        frames: args.frames,
+        speed: args.speed,
+        yaw_rate: 0.0,
+        ideal: false,
+        format: "pcd,ply,kitti,las".into(),
+        threads: None,
+        backend: "bvh".into(),
+    };
+    let manifest = super::scan::scan_to_dir(&scan_args)?;
+    println!(
+        "1. scanned `{}` with `{}`: {} frame(s) -> {}",
+        args.scene,
+        args.rig,
+        manifest.frames.len(),
+        scan_dir.display()
+    );
+
+    std::fs::create_dir_all(&class_dir).with_context(|| format!("creating {}", class_dir.display()))?;
+    let mut eval = Evaluation::default();
+    for f in &manifest.frames {
+        let cloud = sim::io::pcd::read(&scan_dir.join(&f.file))?;
+        let input = FrameInput {
+            index: f.index,
+            cloud: &cloud,
+            world_from_vehicle: Some(affine_from_rows(&f.world_from_vehicle)),
+        };
+        let ground = method.classify(&input).with_context(|| format!("classifying frame {}", f.index))?;
+        eval.add_frame(&cloud, &ground);
+        let stem = format!("frame_{:06}", f.index);
+        let bytes: Vec<u8> = ground.iter().map(|&g| u8::from(g)).collect();
+        sim::io::atomic::write_bytes_atomic(&class_dir.join(format!("{stem}.ground")), &bytes)?;
+        if f.index == 0 {
+            let opts = BevOptions::default();
+            save_png(&args.out.join("scan_class.png"), &render_bev(&cloud, &Coloring::Class, &opts)?)?;
+            let outcome = Coloring::Outcome { predicted_ground: &ground };
+            save_png(&args.out.join("outcome.png"), &render_bev(&cloud, &outcome, &opts)?)?;
+        }
+    }
+    println!("2. classified with `{}` -> {}", args.method, class_dir.display());
+
+    let s = eval.pooled.scores();
+    println!("3. scores against the ground truth ({} points):", eval.pooled.total());
+    println!(
+        "   {:<10} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}",
+        "method", "acc", "FPR", "precision", "recall", "F1", "IoU"
+    );
+    println!(
+        "   {:<10} {:>7.4} {:>7.4} {:>9.4} {:>7.4} {:>7.4} {:>7.4}",
+        args.method, s.acc, s.fpr, s.precision, s.recall, s.f1, s.iou
+    );
+    let json = serde_json::json!({ "scene": args.scene, "rig": args.rig, "methods": { args.method.clone(): s } });
+    sim::io::atomic::write_bytes_atomic(&args.out.join("eval.json"), serde_json::to_string_pretty(&json)?.as_bytes())?;
+
+    let scene_png = args.out.join("scene.png");
+    super::render_scene::run(&super::render::Args {
+        scene: Some(args.scene.clone()),
+        input: None,
+        frame: 0,
+        view: "bev".into(),
+        color: "class".into(),
+        seed: args.seed,
+        out: scene_png.clone(),
+    })?;
+    println!(
+        "4. pictures: {} (scene from above), {} (scan by class), {} (true / false / missed ground)",
+        scene_png.display(),
+        args.out.join("scan_class.png").display(),
+        args.out.join("outcome.png").display()
+    );
+    Ok(())
+}
