@@ -1,0 +1,74 @@
+//! Scenario tests on the hard cases of seed 000 and 002: ramps, basins (the elevated target beyond
+//! a lowered surface), elevated non-ground surfaces, forests, and the sensor at other mounts.
+
+use gt_tests::run;
+
+#[test]
+fn ramp_up_and_down_stay_ground() {
+    for scene in ["ramp-up", "ramp-down"] {
+        let s = run(scene, "hdl64e-roof", "nitsch", 1, 0.0);
+        let sc = s.eval.pooled.scores();
+        eprintln!("{scene}: {sc:?}");
+        assert!(sc.f1 >= 0.97, "{scene}: F1 {}", sc.f1);
+        assert!(sc.fpr <= 0.05, "{scene}: FPR {}", sc.fpr);
+    }
+}
+
+#[test]
+fn ground_beyond_a_basin_is_ground() {
+    let s = run("basin", "os1-128-roof", "nitsch", 1, 0.0);
+    let c = &s.frames[0].cloud;
+    let d = &s.decisions[0];
+    // Ground far from the vehicle (beyond the basin) must still be found: recall over ground
+    // returns farther than 25 m.
+    let far: Vec<usize> = (0..c.len()).filter(|&i| c.has_return(i) && c.ground[i] && c.range_m[i] > 25.0).collect();
+    assert!(far.len() > 1000, "far ground seen ({})", far.len());
+    let found = far.iter().filter(|&&i| d[i]).count();
+    let recall = found as f64 / far.len() as f64;
+    eprintln!("basin far-ground recall {recall}");
+    assert!(recall >= 0.9, "far ground recall {recall}");
+    assert!(s.eval.pooled.scores().f1 >= 0.97);
+}
+
+#[test]
+fn flat_roofs_docks_and_tables_are_not_ground() {
+    let s = run("elevated", "hdl64e-roof", "nitsch", 1, 0.0);
+    let c = &s.frames[0].cloud;
+    let d = &s.decisions[0];
+    // Flat, horizontal, non-ground returns (roofs, docks, tables): normal within 10 deg of +z.
+    let flat_non_ground: Vec<usize> =
+        (0..c.len()).filter(|&i| c.has_return(i) && !c.ground[i] && c.normal[i].z > 0.985).collect();
+    assert!(flat_non_ground.len() > 200, "elevated flat surfaces seen ({})", flat_non_ground.len());
+    let called = flat_non_ground.iter().filter(|&&i| d[i]).count();
+    let rate = called as f64 / flat_non_ground.len() as f64;
+    eprintln!("elevated flat non-ground called ground: {rate}");
+    assert!(rate <= 0.2, "{rate} of flat non-ground surfaces called ground");
+}
+
+#[test]
+fn forest_ground_is_found_under_the_trees_by_the_nodding_laser() {
+    // Seed 002's sparse-scene rig: the nodding UTM-30LX with 180 deg of its field of view, ideal
+    // ranges. (With 1 cm range noise the method loses ground near the sensor, where neighbouring
+    // beams are only millimetres apart; with the full 270 deg the beams behind the tilt axis run
+    // down as the nod goes up, so their rows are in reverse elevation order. Both are documented
+    // limits of an automotive method on this rig.)
+    let rig_file = concat!(env!("CARGO_MANIFEST_DIR"), "/../sim/rigs/nodding-180.toml");
+    let rig = sim::Rig::load(rig_file).unwrap();
+    for name in ["forest-sparse", "forest-moderate"] {
+        let scene = scenes::load(name, 0).unwrap();
+        let config = sim::scan::ScanConfig { ideal: true, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
+        let frames = sim::scan::scan(&scene.mesh, &rig, &config).unwrap();
+        assert_eq!((frames[0].cloud.rows, frames[0].cloud.cols), (200, 721));
+        let sc = gt_tests::classify(frames, "nitsch").eval.pooled.scores();
+        eprintln!("{name} nodding-180 ideal: {sc:?}");
+        assert!(sc.f1 >= 0.98, "{name}: F1 {}", sc.f1);
+    }
+}
+
+#[test]
+fn plane_fitting_is_clearly_worse_than_the_method_on_rural_roads() {
+    let nitsch = run("rural", "lux-roof-4", "nitsch", 1, 0.0).eval.pooled.scores();
+    let ransac = run("rural", "lux-roof-4", "ransac", 1, 0.0).eval.pooled.scores();
+    eprintln!("rural: nitsch {nitsch:?} ransac {ransac:?}");
+    assert!(nitsch.acc > ransac.acc + 0.1, "nitsch accuracy {} vs ransac {}", nitsch.acc, ransac.acc);
+}
