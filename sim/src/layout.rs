@@ -17,7 +17,6 @@
 //!
 //! For a single sensor the layout is the identity: its own grid is already ordered.
 
-use glam::Vec3;
 
 use crate::rig::Rig;
 use crate::sensor::ScanPattern;
@@ -49,7 +48,7 @@ impl RigLayout {
             for r in 0..p.rows {
                 let fired: Vec<_> = (0..p.cols).filter_map(|c| p.at(r, c)).collect();
                 let elev = fired.get(fired.len() / 2).map_or(p.row_elevation_rad[r], |f| {
-                    let d = rot * Vec3::from(f.dir_in_sensor);
+                    let d = rot * f.dir_in_sensor;
                     d.z.clamp(-1.0, 1.0).asin()
                 });
                 rings.push((elev, s, r));
