@@ -17,7 +17,6 @@
 //!
 //! For a single sensor the layout is the identity: its own grid is already ordered.
 
-
 use crate::rig::Rig;
 use crate::sensor::ScanPattern;
 
