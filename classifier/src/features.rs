@@ -26,6 +26,9 @@
 //!   drops the lower neighbours of far ground, which are naturally nearer by about
 //!   `range * beam gap / height`.
 
+// Lane arrays are indexed by neighbour and lane on purpose (vectorized across cells).
+#![allow(clippy::needless_range_loop)]
+
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result, is_valid};
@@ -85,6 +88,17 @@ pub struct Features {
     pub n_rho: Vec<f32>,
     /// Ground quality `g_rho` (Eq. 4), in `[-1, 1]`; 0 where the cell has no features.
     pub g_rho: Vec<f32>,
+    /// Structure-of-arrays copy of the plane's points (reused between frames).
+    soa: Soa,
+}
+
+/// The plane's coordinates as separate arrays and a validity flag per cell.
+#[derive(Clone, Debug, Default)]
+struct Soa {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    valid: Vec<bool>,
 }
 
 impl Features {
@@ -96,104 +110,395 @@ impl Features {
     }
 }
 
+/// Cells processed together: the arithmetic runs lane-wise over `L` consecutive cells of a row,
+/// so it vectorizes across cells (each lane does exactly the scalar operations, in the same order).
+const L: usize = 8;
+
+/// Grid offsets `(row, col)` of `d1..d8` (see [`crate::neighbours`]).
+const OFFSETS: [(isize, isize); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
+
+/// Neighbour offsets of `L` cells, lane-wise: `dx[k][l]` is `d_(k+1)` of lane `l` (0 where missing).
+struct Lanes {
+    dx: [[f32; L]; 8],
+    dy: [[f32; L]; 8],
+    dz: [[f32; L]; 8],
+    ok: [[f32; L]; 8],
+}
+
+/// What the per-neighbour test needs besides the points.
+#[derive(Clone, Copy)]
+struct Tests {
+    max_d2: f32,
+    keep: [f32; 8],
+}
+
+impl Tests {
+    /// Whether neighbour `k` with offset `d` and range `range_j` counts for a cell of range `range`.
+    // `!(a < b)` rather than `partial_cmp`: it vectorizes, and a NaN range keeps the neighbour.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    #[inline(always)]
+    fn keep(&self, k: usize, d: [f32; 3], range_j: f32, range: f32) -> bool {
+        // glam's length_squared: (x * x + y * y) + z * z.
+        let l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        // Neighbours nearer than `keep[k] * range` occlude the cell (NaN ranges compare false: kept).
+        l2 <= self.max_d2 && l2 > 0.0 && !(range_j < self.keep[k] * range)
+    }
+}
+
 /// Computes the features of every cell of `view` into `out`.
+///
+/// Cells whose 8 direct neighbours all hold returns (the common case) take their offsets straight
+/// from the neighbouring rows, 8 cells at a time; the others use [`GridView::neighbours`]. Either
+/// way every cell gets bit-for-bit the result of the per-cell definition (tested against it).
 pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return compute_features_avx2(view, params, out);
+        }
+    }
+    compute_features_body(view, params, out);
+}
+
+/// [`compute_features_body`] compiled for AVX2 (8 lanes per instruction). Only plain IEEE
+/// operations are used (no fused multiply-add), so the results are the same bits as without AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn compute_features_avx2(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
+    compute_features_body(view, params, out);
+}
+
+/// The body of [`compute_features`], inlined into each instruction-set variant.
+#[inline(always)]
+fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     let (rows, cols) = (view.rows, view.cols);
-    out.resize(rows * cols);
-    let max_d2 = params.max_neighbour_distance_m * params.max_neighbour_distance_m;
-    let min_pairs = params.min_valid_pairs;
+    let n = rows * cols;
+    out.resize(n);
+    let soa = &mut out.soa;
+    soa.x.clear();
+    soa.y.clear();
+    soa.z.clear();
+    soa.valid.clear();
+    soa.x.extend(view.points[..n].iter().map(|p| p.x));
+    soa.y.extend(view.points[..n].iter().map(|p| p.y));
+    soa.z.extend(view.points[..n].iter().map(|p| p.z));
+    soa.valid.extend(view.points[..n].iter().map(|&p| is_valid(p)));
     // Ratio 0 switches the test off (keep every neighbour: factor 0).
     let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
     let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
-    let keep = [up, up, other, other, other, other, other, up];
+    let tests = Tests {
+        max_d2: params.max_neighbour_distance_m * params.max_neighbour_distance_m,
+        keep: [up, up, other, other, other, other, other, up],
+    };
+    let min_pairs = params.min_valid_pairs as f32;
+    let ranges = &view.ranges[..n];
+    let mut lanes = Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8] };
     for r in 0..rows {
-        for c in 0..cols {
-            let i = r * cols + c;
-            let p = view.points[i];
-            let (n, n_rho) = if is_valid(p) {
-                cell_features(view, i, p, view.neighbours(r, c), max_d2, keep, min_pairs)
+        let interior_row = r > 0 && r + 1 < rows;
+        let mut c0 = 0;
+        while c0 < cols {
+            let m = (cols - c0).min(L);
+            let i0 = r * cols + c0;
+            // The fast path needs all 3 x (L + 2) cells around the L cells to hold returns.
+            let dense = interior_row
+                && m == L
+                && c0 > 0
+                && c0 + L < cols
+                && [i0 - cols, i0, i0 + cols].iter().all(|&b| soa.valid[b - 1..b + L + 1].iter().all(|&v| v));
+            let mut cell_ok = [true; L];
+            if dense {
+                fill_dense(soa, ranges, i0, cols, &tests, &mut lanes);
             } else {
-                (Vec3::ZERO, 0.0)
-            };
-            out.normal[i] = n;
-            out.n_rho[i] = n_rho;
-            out.g_rho[i] = n.z * n_rho;
+                for l in 0..L {
+                    cell_ok[l] = l < m && fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
+                }
+            }
+            let (nx, ny, nz, rho) = lane_features(&lanes, min_pairs);
+            for l in 0..m {
+                let i = i0 + l;
+                let (n, n_rho) = if cell_ok[l] { (Vec3::new(nx[l], ny[l], nz[l]), rho[l]) } else { (Vec3::ZERO, 0.0) };
+                out.normal[i] = n;
+                out.n_rho[i] = n_rho;
+                out.g_rho[i] = n.z * n_rho;
+            }
+            c0 += m;
         }
     }
 }
 
-/// Eq. 1-3 for one cell at `p` with neighbour cells `nb` (order `d1..d8`).
-///
-/// Written branch-free over 8 lanes (`[f32; 8]` per coordinate) so the compiler vectorizes it:
-/// missing neighbours and degenerate pairs get weight 0 instead of a branch.
+/// Offsets of the `L` cells from `i0` on, all with their 8 direct neighbours present.
+#[inline(always)]
+fn fill_dense(soa: &Soa, ranges: &[f32], i0: usize, cols: usize, tests: &Tests, lanes: &mut Lanes) {
+    let at = |a: &[f32], i: usize| -> [f32; L] { a[i..i + L].try_into().expect("L cells") };
+    let (px, py, pz, pr) = (at(&soa.x, i0), at(&soa.y, i0), at(&soa.z, i0), at(ranges, i0));
+    for (k, &(dr, dc)) in OFFSETS.iter().enumerate() {
+        let j0 = (i0 as isize + dr * cols as isize + dc) as usize;
+        let (qx, qy, qz, qr) = (at(&soa.x, j0), at(&soa.y, j0), at(&soa.z, j0), at(ranges, j0));
+        for l in 0..L {
+            let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
+            let keep = tests.keep(k, d, qr[l], pr[l]);
+            lanes.dx[k][l] = if keep { d[0] } else { 0.0 };
+            lanes.dy[k][l] = if keep { d[1] } else { 0.0 };
+            lanes.dz[k][l] = if keep { d[2] } else { 0.0 };
+            lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
+        }
+    }
+}
+
+/// Offsets of cell `(r, c)` into lane `l` by the general neighbour search; false if it has no return.
+#[allow(clippy::too_many_arguments)]
 #[inline]
-fn cell_features(
+fn fill_one(
     view: &GridView<'_>,
-    i: usize,
-    p: Vec3,
-    nb: [Option<usize>; 8],
-    max_d2: f32,
-    keep: [f32; 8],
-    min_pairs: usize,
-) -> (Vec3, f32) {
-    let (mut dx, mut dy, mut dz, mut ok) = ([0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8]);
-    // Neighbours nearer than `keep[k] * range` occlude the cell (NaN ranges compare false: kept).
-    let range = view.ranges[i];
-    for k in 0..8 {
-        if let Some(j) = nb[k] {
-            let d = view.points[j] - p;
-            let l2 = d.length_squared();
-            if l2 <= max_d2
-                && l2 > 0.0
-                && view.ranges[j].partial_cmp(&(keep[k] * range)) != Some(std::cmp::Ordering::Less)
-            {
-                (dx[k], dy[k], dz[k], ok[k]) = (d.x, d.y, d.z, 1.0);
+    soa: &Soa,
+    ranges: &[f32],
+    r: usize,
+    c: usize,
+    l: usize,
+    tests: &Tests,
+    lanes: &mut Lanes,
+) -> bool {
+    let i = r * view.cols + c;
+    let nb = if soa.valid[i] { view.neighbours(r, c) } else { [None; 8] };
+    for (k, j) in nb.into_iter().enumerate() {
+        let (mut d, mut ok) = ([0.0; 3], 0.0);
+        if let Some(j) = j {
+            let dj = [soa.x[j] - soa.x[i], soa.y[j] - soa.y[i], soa.z[j] - soa.z[i]];
+            if tests.keep(k, dj, ranges[j], ranges[i]) {
+                (d, ok) = (dj, 1.0);
             }
         }
+        (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l], lanes.ok[k][l]) = (d[0], d[1], d[2], ok);
     }
-    pair_features(&dx, &dy, &dz, &ok, min_pairs)
+    soa.valid[i]
 }
 
-/// Eq. 1-3 from the neighbour offsets (lane k = `d_(k+1)`; `ok` 1 where the neighbour exists).
-#[inline]
-fn pair_features(dx: &[f32; 8], dy: &[f32; 8], dz: &[f32; 8], ok: &[f32; 8], min_pairs: usize) -> (Vec3, f32) {
-    // The previous neighbour of lane k is lane k - 1 (lane 7 for lane 0): Eq. 1's d_(i-1) and d_8.
-    let prev = |a: &[f32; 8]| [a[7], a[0], a[1], a[2], a[3], a[4], a[5], a[6]];
-    let (px, py, pz, pok) = (prev(dx), prev(dy), prev(dz), prev(ok));
-    let mut len = [0f32; 8];
+/// Eq. 1-3 for `L` cells from their neighbour offsets: the unit normal `(nx, ny, nz)` and `n_rho`
+/// per lane, zeros where a cell has too few pairs or a degenerate sum.
+///
+/// Every lane does the operations of the per-cell definition in its order (sums over `k` from
+/// `d1` to `d8`), so the results are bit-for-bit those of one cell at a time:
+/// - a pair normal `n_i = d_i x d_(i-1)` exists when both neighbours do and it is not degenerate;
+/// - Eq. 2 weight `1 / (|d_i| + |d_(i-1)|)`, Eq. 3 term `(n . n_i) / |n_i|` averaged over pairs.
+#[inline(always)]
+fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
+    let (dx, dy, dz, ok) = (&d.dx, &d.dy, &d.dz, &d.ok);
+    let mut len = [[0f32; L]; 8];
     for k in 0..8 {
-        len[k] = (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
+        for l in 0..L {
+            len[k][l] = (dx[k][l] * dx[k][l] + dy[k][l] * dy[k][l] + dz[k][l] * dz[k][l]).sqrt();
+        }
     }
-    let plen = prev(&len);
-    let (mut nx, mut ny, mut nz, mut w, mut inv) = ([0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8]);
+    let (mut nx, mut ny, mut nz, mut inv) = ([[0f32; L]; 8], [[0f32; L]; 8], [[0f32; L]; 8], [[0f32; L]; 8]);
+    let (mut sx, mut sy, mut sz, mut pairs) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
     for k in 0..8 {
-        // Eq. 1: n_i = d_i x d_(i-1).
-        nx[k] = dy[k] * pz[k] - dz[k] * py[k];
-        ny[k] = dz[k] * px[k] - dx[k] * pz[k];
-        nz[k] = dx[k] * py[k] - dy[k] * px[k];
-        let nl = (nx[k] * nx[k] + ny[k] * ny[k] + nz[k] * nz[k]).sqrt();
-        // A pair exists when both neighbours do and the cross product is not degenerate.
-        let valid = ok[k] * pok[k] * f32::from(u8::from(nl > 1e-12 * len[k] * plen[k]));
-        // Eq. 2 weight 1 / (|d_i| + |d_(i-1)|); Eq. 3 needs 1 / |n_i|.
-        inv[k] = valid / nl.max(f32::MIN_POSITIVE);
-        w[k] = valid / (len[k] + plen[k]).max(f32::MIN_POSITIVE);
+        // The previous neighbour of d1 is d8 (Eq. 1's d_(i-1)).
+        let p = (k + 7) % 8;
+        for l in 0..L {
+            let x = dy[k][l] * dz[p][l] - dz[k][l] * dy[p][l];
+            let y = dz[k][l] * dx[p][l] - dx[k][l] * dz[p][l];
+            let z = dx[k][l] * dy[p][l] - dy[k][l] * dx[p][l];
+            let nl = (x * x + y * y + z * z).sqrt();
+            let valid = ok[k][l] * ok[p][l] * f32::from(u8::from(nl > 1e-12 * len[k][l] * len[p][l]));
+            let iv = valid / nl.max(f32::MIN_POSITIVE);
+            let w = valid / (len[k][l] + len[p][l]).max(f32::MIN_POSITIVE);
+            (nx[k][l], ny[k][l], nz[k][l], inv[k][l]) = (x, y, z, iv);
+            sx[l] += x * w;
+            sy[l] += y * w;
+            sz[l] += z * w;
+            pairs[l] += f32::from(u8::from(iv > 0.0));
+        }
     }
-    let (mut sx, mut sy, mut sz, mut pairs) = (0f32, 0f32, 0f32, 0f32);
-    for k in 0..8 {
-        sx += nx[k] * w[k];
-        sy += ny[k] * w[k];
-        sz += nz[k] * w[k];
-        pairs += f32::from(u8::from(inv[k] > 0.0));
+    let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+    for l in 0..L {
+        let sum_len = (sx[l] * sx[l] + sy[l] * sy[l] + sz[l] * sz[l]).sqrt();
+        let good = pairs[l] >= min_pairs && sum_len > 0.0 && sum_len.is_finite();
+        let (ux, uy, uz) = (sx[l] / sum_len, sy[l] / sum_len, sz[l] / sum_len);
+        // Eq. 3: mean cosine similarity between n and its generating normals.
+        let mut cos_sum = 0.0f32;
+        for k in 0..8 {
+            cos_sum += (ux * nx[k][l] + uy * ny[k][l] + uz * nz[k][l]) * inv[k][l];
+        }
+        let q = cos_sum / pairs[l];
+        (ox[l], oy[l], oz[l], rho[l]) = if good { (ux, uy, uz, q) } else { (0.0, 0.0, 0.0, 0.0) };
     }
-    let sum_len = (sx * sx + sy * sy + sz * sz).sqrt();
-    if (pairs as usize) < min_pairs || !(sum_len > 0.0 && sum_len.is_finite()) {
-        return (Vec3::ZERO, 0.0);
+    (ox, oy, oz, rho)
+}
+
+#[cfg(test)]
+mod tests {
+    //! The lane-wise computation against the per-cell definition it replaced (kept here verbatim
+    //! as the reference), bit for bit, on damaged synthetic frames.
+
+    use super::*;
+    use crate::neighbours::detect_wrap;
+    use crate::synthetic::{SyntheticSensor, car, flat_ground};
+    use rand::{RngExt, SeedableRng};
+
+    /// The per-cell definition: neighbours by [`GridView::neighbours`], then Eq. 1-3.
+    fn reference(view: &GridView<'_>, params: &FeatureParams) -> Vec<(Vec3, f32, f32)> {
+        let max_d2 = params.max_neighbour_distance_m * params.max_neighbour_distance_m;
+        let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
+        let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
+        let keep = [up, up, other, other, other, other, other, up];
+        let mut out = Vec::new();
+        for r in 0..view.rows {
+            for c in 0..view.cols {
+                let i = r * view.cols + c;
+                let p = view.points[i];
+                let (n, n_rho) = if is_valid(p) {
+                    cell_features(view, i, p, view.neighbours(r, c), max_d2, keep, params.min_valid_pairs)
+                } else {
+                    (Vec3::ZERO, 0.0)
+                };
+                out.push((n, n_rho, n.z * n_rho));
+            }
+        }
+        out
     }
-    let n = Vec3::new(sx, sy, sz) / sum_len;
-    // Eq. 3: mean cosine similarity between n and its generating normals.
-    let mut cos_sum = 0.0;
-    for k in 0..8 {
-        cos_sum += (n.x * nx[k] + n.y * ny[k] + n.z * nz[k]) * inv[k];
+
+    /// Eq. 1-3 for one cell at `p` with neighbour cells `nb` (order `d1..d8`).
+    ///
+    /// Written branch-free over 8 lanes (`[f32; 8]` per coordinate) so the compiler vectorizes it:
+    /// missing neighbours and degenerate pairs get weight 0 instead of a branch.
+    #[inline]
+    fn cell_features(
+        view: &GridView<'_>,
+        i: usize,
+        p: Vec3,
+        nb: [Option<usize>; 8],
+        max_d2: f32,
+        keep: [f32; 8],
+        min_pairs: usize,
+    ) -> (Vec3, f32) {
+        let (mut dx, mut dy, mut dz, mut ok) = ([0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8]);
+        // Neighbours nearer than `keep[k] * range` occlude the cell (NaN ranges compare false: kept).
+        let range = view.ranges[i];
+        for k in 0..8 {
+            if let Some(j) = nb[k] {
+                let d = view.points[j] - p;
+                let l2 = d.length_squared();
+                if l2 <= max_d2
+                    && l2 > 0.0
+                    && view.ranges[j].partial_cmp(&(keep[k] * range)) != Some(std::cmp::Ordering::Less)
+                {
+                    (dx[k], dy[k], dz[k], ok[k]) = (d.x, d.y, d.z, 1.0);
+                }
+            }
+        }
+        pair_features(&dx, &dy, &dz, &ok, min_pairs)
     }
-    (n, cos_sum / pairs)
+
+    /// Eq. 1-3 from the neighbour offsets (lane k = `d_(k+1)`; `ok` 1 where the neighbour exists).
+    #[inline]
+    fn pair_features(dx: &[f32; 8], dy: &[f32; 8], dz: &[f32; 8], ok: &[f32; 8], min_pairs: usize) -> (Vec3, f32) {
+        // The previous neighbour of lane k is lane k - 1 (lane 7 for lane 0): Eq. 1's d_(i-1) and d_8.
+        let prev = |a: &[f32; 8]| [a[7], a[0], a[1], a[2], a[3], a[4], a[5], a[6]];
+        let (px, py, pz, pok) = (prev(dx), prev(dy), prev(dz), prev(ok));
+        let mut len = [0f32; 8];
+        for k in 0..8 {
+            len[k] = (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
+        }
+        let plen = prev(&len);
+        let (mut nx, mut ny, mut nz, mut w, mut inv) = ([0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8]);
+        for k in 0..8 {
+            // Eq. 1: n_i = d_i x d_(i-1).
+            nx[k] = dy[k] * pz[k] - dz[k] * py[k];
+            ny[k] = dz[k] * px[k] - dx[k] * pz[k];
+            nz[k] = dx[k] * py[k] - dy[k] * px[k];
+            let nl = (nx[k] * nx[k] + ny[k] * ny[k] + nz[k] * nz[k]).sqrt();
+            // A pair exists when both neighbours do and the cross product is not degenerate.
+            let valid = ok[k] * pok[k] * f32::from(u8::from(nl > 1e-12 * len[k] * plen[k]));
+            // Eq. 2 weight 1 / (|d_i| + |d_(i-1)|); Eq. 3 needs 1 / |n_i|.
+            inv[k] = valid / nl.max(f32::MIN_POSITIVE);
+            w[k] = valid / (len[k] + plen[k]).max(f32::MIN_POSITIVE);
+        }
+        let (mut sx, mut sy, mut sz, mut pairs) = (0f32, 0f32, 0f32, 0f32);
+        for k in 0..8 {
+            sx += nx[k] * w[k];
+            sy += ny[k] * w[k];
+            sz += nz[k] * w[k];
+            pairs += f32::from(u8::from(inv[k] > 0.0));
+        }
+        let sum_len = (sx * sx + sy * sy + sz * sz).sqrt();
+        if (pairs as usize) < min_pairs || !(sum_len > 0.0 && sum_len.is_finite()) {
+            return (Vec3::ZERO, 0.0);
+        }
+        let n = Vec3::new(sx, sy, sz) / sum_len;
+        // Eq. 3: mean cosine similarity between n and its generating normals.
+        let mut cos_sum = 0.0;
+        for k in 0..8 {
+            cos_sum += (n.x * nx[k] + n.y * ny[k] + n.z * nz[k]) * inv[k];
+        }
+        (n, cos_sum / pairs)
+    }
+
+    /// A small spinning frame with cars, a fraction `drop` of returns removed and z noise.
+    fn frame(drop: f32, seed: u64, spinning: bool) -> sim::OrderedCloud {
+        let shapes = [flat_ground(), car(6.0, 1.0, 0.0), car(-9.0, -2.0, 0.0)];
+        let sensor = if spinning {
+            SyntheticSensor::spinning(24, 360, -25.0, 5.0, 1.8)
+        } else {
+            SyntheticSensor::forward(24, 200, -25.0, 5.0, 90.0, 1.8)
+        };
+        let mut cloud = sensor.scan(&shapes);
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+        for i in 0..cloud.point_in_vehicle.len() {
+            if rng.random::<f32>() < drop {
+                cloud.point_in_vehicle[i] = Vec3::NAN;
+                cloud.range_m[i] = f32::NAN;
+            } else {
+                cloud.point_in_vehicle[i].z += rng.random::<f32>() * 0.06 - 0.03;
+            }
+        }
+        cloud
+    }
+
+    #[test]
+    fn lane_wise_features_equal_the_per_cell_definition_bit_for_bit() {
+        let mut checked = 0;
+        for (drop, seed, spinning) in [(0.0, 1, true), (0.1, 2, true), (0.4, 3, true), (0.2, 4, false)] {
+            let cloud = frame(drop, seed, spinning);
+            assert_eq!(detect_wrap(&cloud.point_in_vehicle, cloud.rows, cloud.cols), spinning);
+            for (gap, params) in [
+                (2, FeatureParams::default()),
+                (
+                    3,
+                    FeatureParams {
+                        min_valid_pairs: 3,
+                        max_neighbour_distance_m: 2.0,
+                        occlusion_ratio: 0.1,
+                        upper_occlusion_ratio: 0.05,
+                    },
+                ),
+                (1, FeatureParams { upper_occlusion_ratio: 0.0, ..FeatureParams::default() }),
+            ] {
+                let mut nitsch = crate::NitschParams::default();
+                nitsch.neighbours.max_col_gap = gap;
+                let classifier = crate::Nitsch::new(nitsch).expect("valid parameters");
+                let view = classifier.view(&cloud);
+                let (mut fast, mut generic) = (Features::default(), Features::default());
+                compute_features(&view, &params, &mut fast);
+                // The portable variant too (the dispatcher above may have picked AVX2).
+                compute_features_body(&view, &params, &mut generic);
+                assert_eq!(
+                    fast.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>(),
+                    generic.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>()
+                );
+                let want = reference(&view, &params);
+                for (i, &(n, n_rho, g_rho)) in want.iter().enumerate() {
+                    let got = (fast.normal[i], fast.n_rho[i], fast.g_rho[i]);
+                    let bits = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+                    assert_eq!(bits(got.0), bits(n), "normal of cell {i} (drop {drop}, gap {gap})");
+                    assert_eq!(got.1.to_bits(), n_rho.to_bits(), "n_rho of cell {i}");
+                    assert_eq!(got.2.to_bits(), g_rho.to_bits(), "g_rho of cell {i}");
+                    checked += usize::from(n_rho > 0.5);
+                }
+            }
+        }
+        // Most cells are real ground with features, not trivially equal zeros.
+        assert!(checked > 20_000, "{checked}");
+    }
 }
