@@ -18,7 +18,12 @@
 //! searched up to `max_col_gap` columns away along the row, because merged multi-sensor grids and
 //! dropouts leave empty cells between physical neighbours. In the rows above and below, the centre
 //! neighbour (`d1`, `d5`) is the return nearest to the cell's column (within `max_col_gap`, `+` side
-//! first on ties), and the diagonal neighbours are the next returns beyond it on either side. With a
+//! first on ties), and the diagonal neighbours are the next returns beyond it on either side. A row
+//! with no return within `max_col_gap` of the column is skipped, up to [`MAX_ROW_GAP`] rows away: on
+//! the merged `lux-roof-4` grid two of every four layers have a narrower field of view (85 instead
+//! of 110 degrees), so near the left and right edges every other pair of rows is empty and the
+//! physical neighbour of a ring lies two rows further (measured on `rural`: without the skip, far
+//! terrain at the edges had neighbours only along its own row, no normal and no ground). With a
 //! dense grid this is exactly the plain 8-neighbourhood. Beyond the grid's top and bottom rows there
 //! is nothing; beyond its left and right columns the search wraps only for 360-degree sensors
 //! ([`Wrap`]). A neighbour farther than `max_distance_m` from the cell is dropped (the paper uses no
@@ -27,6 +32,11 @@
 use glam::Vec3;
 
 use crate::error::is_valid;
+
+/// How many rows up or down [`GridView::neighbours`] looks for a row with a return near the
+/// column (module docs): 3 skips the two empty rows at the edges of the merged `lux-roof-4` grid.
+/// On grids without empty rows it changes nothing.
+pub const MAX_ROW_GAP: usize = 3;
 
 /// Whether column 0 and column `cols - 1` are neighbours (a sensor that spins all the way round).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -145,23 +155,22 @@ impl<'a> GridView<'a> {
             return idx.map(Some);
         }
         let mut out = [None; 8];
-        if r + 1 < self.rows {
-            let up = r + 1;
-            if let Some(cc) = self.nearest_in_row(up, c) {
-                out[0] = Some(up * cols + cc);
-                out[1] = self.first_along(up, cc, 1).map(|x| up * cols + x);
-                out[7] = self.first_along(up, cc, -1).map(|x| up * cols + x);
-            }
+        // The nearest row above (below) with a return near the column, skipping empty rows.
+        let gap = MAX_ROW_GAP;
+        if let Some((up, cc)) =
+            (r + 1..self.rows.min(r + 1 + gap)).find_map(|up| Some((up, self.nearest_in_row(up, c)?)))
+        {
+            out[0] = Some(up * cols + cc);
+            out[1] = self.first_along(up, cc, 1).map(|x| up * cols + x);
+            out[7] = self.first_along(up, cc, -1).map(|x| up * cols + x);
         }
         out[2] = self.first_along(r, c, 1).map(|x| r * cols + x);
         out[6] = self.first_along(r, c, -1).map(|x| r * cols + x);
-        if r > 0 {
-            let dn = r - 1;
-            if let Some(cc) = self.nearest_in_row(dn, c) {
-                out[4] = Some(dn * cols + cc);
-                out[3] = self.first_along(dn, cc, 1).map(|x| dn * cols + x);
-                out[5] = self.first_along(dn, cc, -1).map(|x| dn * cols + x);
-            }
+        if let Some((dn, cc)) = (r.saturating_sub(gap)..r).rev().find_map(|dn| Some((dn, self.nearest_in_row(dn, c)?)))
+        {
+            out[4] = Some(dn * cols + cc);
+            out[3] = self.first_along(dn, cc, 1).map(|x| dn * cols + x);
+            out[5] = self.first_along(dn, cc, -1).map(|x| dn * cols + x);
         }
         out
     }

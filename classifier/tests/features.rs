@@ -1,7 +1,7 @@
 //! Feature tests on analytic synthetic clouds: flat ground, walls, missing neighbours, wrap-around.
 
 use classifier::features::{FeatureParams, Features, compute_features};
-use classifier::neighbours::{GridView, detect_wrap};
+use classifier::neighbours::{GridView, MAX_ROW_GAP, detect_wrap};
 use classifier::synthetic::{Shape, SyntheticSensor, flat_ground};
 use glam::Vec3;
 use sim::{OrderedCloud, SemanticClass};
@@ -82,8 +82,8 @@ fn missing_neighbours_are_skipped_or_bridged() {
     // Knock out the right neighbour of (3, 20): the gap search takes (3, 22) instead.
     cloud.point_in_vehicle[at(3, 21)] = Vec3::NAN;
     cloud.range_m[at(3, 21)] = f32::NAN;
-    // An isolated return: everything around (1, 5) empty, up to 2 columns away.
-    for r in 0..3 {
+    // An isolated return: everything around (1, 5) empty, up to 2 columns and 3 rows away.
+    for r in 0..5 {
         for c in 3..=7 {
             if (r, c) != (1, 5) {
                 cloud.point_in_vehicle[at(r, c)] = Vec3::NAN;
@@ -172,4 +172,49 @@ fn an_upper_neighbour_in_front_of_the_cell_is_an_occluder() {
     assert!(without.g_rho[i] < 0.6, "occluders kept: g_rho {}", without.g_rho[i]);
     // Ratio checks are refused outside [0, 1).
     assert!(FeatureParams { occlusion_ratio: 1.0, ..Default::default() }.validate().is_err());
+}
+
+#[test]
+fn empty_rows_of_a_merged_grid_are_skipped_up_to_max_row_gap() {
+    // The merged lux-roof-4 pattern: of every 4 rows, the upper 2 have a narrower field of view, so
+    // near the left and right edges rows 2, 3, 6, 7, 10, 11 are empty. Row 12 (the top ring) then
+    // has no return in the rows next to it; its physical lower neighbour is row 9.
+    assert_eq!(MAX_ROW_GAP, 3);
+    let (rows, cols) = (13, 40);
+    let mut cloud = SyntheticSensor::forward(rows, cols, -20.0, -5.0, 40.0, 1.8).scan(&[flat_ground()]);
+    assert_eq!(cloud.returns(), rows * cols);
+    let at = |r: usize, c: usize| r * cols + c;
+    let blank = |cloud: &mut OrderedCloud, rows: &[usize]| {
+        for &r in rows {
+            for c in (0..8).chain(32..cols) {
+                cloud.point_in_vehicle[at(r, c)] = Vec3::NAN;
+                cloud.range_m[at(r, c)] = f32::NAN;
+            }
+        }
+    };
+    blank(&mut cloud, &[2, 3, 6, 7, 10, 11]);
+    let view =
+        GridView { points: &cloud.point_in_vehicle, ranges: &cloud.range_m, rows, cols, wrap: false, max_col_gap: 2 };
+    // The lower neighbours of the top ring at the edge are found three rows down.
+    let nb = view.neighbours(12, 4);
+    assert_eq!((nb[3], nb[4], nb[5]), (Some(at(9, 5)), Some(at(9, 4)), Some(at(9, 3))));
+    assert_eq!((nb[0], nb[1], nb[7]), (None, None, None), "nothing above the top row");
+    // Row 4 at the edge looks past the empty rows 3 and 2 to row 1; the centre columns are unchanged.
+    assert_eq!(view.neighbours(4, 4)[4], Some(at(1, 4)));
+    assert_eq!(view.neighbours(4, 20)[4], Some(at(3, 20)));
+    // So flat ground gets g_rho = 1 in every remaining cell, the edges included.
+    let f = features(&cloud, false, FeatureParams::default());
+    for c in 0..cols {
+        for r in [0, 1, 4, 5, 8, 9, 12] {
+            assert!(f.g_rho[at(r, c)] > 0.999, "cell ({r}, {c}): g_rho {}", f.g_rho[at(r, c)]);
+        }
+    }
+    // Three empty rows are beyond the search: the top ring at the edge then has only its two row
+    // neighbours, no pair normal and no features.
+    blank(&mut cloud, &[9]);
+    let view =
+        GridView { points: &cloud.point_in_vehicle, ranges: &cloud.range_m, rows, cols, wrap: false, max_col_gap: 2 };
+    assert_eq!(view.neighbours(12, 4).iter().flatten().count(), 2);
+    let f = features(&cloud, false, FeatureParams::default());
+    assert_eq!(f.g_rho[at(12, 4)], 0.0);
 }
