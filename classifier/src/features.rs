@@ -25,6 +25,13 @@
 //!   with `lux-roof-4`). The same test on all neighbours (`occlusion_ratio`, 0 = off, the default)
 //!   drops the lower neighbours of far ground, which are naturally nearer by about
 //!   `range * beam gap / height`.
+//! - Lateral occlusion (tested): the same test on the neighbours in the cell's own row (`d3`, `d7`;
+//!   `lateral_occlusion_ratio` 0.1). Along a row the range of a surface changes by about
+//!   `column step * tan(incidence)` per column, a few percent even on a wall seen at 85 degrees, so
+//!   a same-row neighbour more than 10 % nearer lies in front of the cell across a range jump: the
+//!   shoulder in front of a ditch whose near bank is in the beam's shadow, a bush in front of the
+//!   field behind it. Measured with `lux-roof-4`, 5 frames: `rural` accuracy 0.925 -> 0.933,
+//!   `city` 0.977 -> 0.981 (0.05 gives the same, 0.2 and 0.3 slightly less).
 
 // Lane arrays are indexed by neighbour and lane on purpose (vectorized across cells).
 #![allow(clippy::needless_range_loop)]
@@ -47,6 +54,9 @@ pub struct FeatureParams {
     /// The same for the neighbours in the row above (`d8`, `d1`, `d2`), which on any surface the
     /// beam does not graze from below are never nearer than the cell by more than a few percent.
     pub upper_occlusion_ratio: f32,
+    /// The same for the neighbours in the cell's own row (`d3`, `d7`), whose range along a surface
+    /// changes by only a few percent per column (0 = off).
+    pub lateral_occlusion_ratio: f32,
 }
 
 impl Default for FeatureParams {
@@ -56,6 +66,7 @@ impl Default for FeatureParams {
             max_neighbour_distance_m: f32::INFINITY,
             occlusion_ratio: 0.0,
             upper_occlusion_ratio: 0.05,
+            lateral_occlusion_ratio: 0.1,
         }
     }
 }
@@ -74,6 +85,9 @@ impl FeatureParams {
         }
         if !(self.upper_occlusion_ratio.is_finite() && (0.0..1.0).contains(&self.upper_occlusion_ratio)) {
             return Err(ClassifyError::invalid("upper_occlusion_ratio", self.upper_occlusion_ratio, "0 ..< 1"));
+        }
+        if !(self.lateral_occlusion_ratio.is_finite() && (0.0..1.0).contains(&self.lateral_occlusion_ratio)) {
+            return Err(ClassifyError::invalid("lateral_occlusion_ratio", self.lateral_occlusion_ratio, "0 ..< 1"));
         }
         Ok(())
     }
@@ -141,7 +155,8 @@ impl Tests {
         // glam's length_squared: (x * x + y * y) + z * z.
         let l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         // Neighbours nearer than `keep[k] * range` occlude the cell (NaN ranges compare false: kept).
-        l2 <= self.max_d2 && l2 > 0.0 && !(range_j < self.keep[k] * range)
+        // `&` rather than `&&`: no branch per lane, so the lanes vectorize.
+        (l2 <= self.max_d2) & (l2 > 0.0) & !(range_j < self.keep[k] * range)
     }
 }
 
@@ -188,9 +203,10 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     // Ratio 0 switches the test off (keep every neighbour: factor 0).
     let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
     let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
+    let lat = factor(params.lateral_occlusion_ratio);
     let tests = Tests {
         max_d2: params.max_neighbour_distance_m * params.max_neighbour_distance_m,
-        keep: [up, up, other, other, other, other, other, up],
+        keep: [up, up, lat, other, other, other, lat, up],
     };
     let min_pairs = params.min_valid_pairs as f32;
     let ranges = &view.ranges[..n];
@@ -207,6 +223,14 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
                 && c0 > 0
                 && c0 + L < cols
                 && [i0 - cols, i0, i0 + cols].iter().all(|&b| soa.valid[b - 1..b + L + 1].iter().all(|&v| v));
+            if !dense && !soa.valid[i0..i0 + m].iter().any(|&v| v) {
+                // No return in these cells (sky): no features.
+                out.normal[i0..i0 + m].fill(Vec3::ZERO);
+                out.n_rho[i0..i0 + m].fill(0.0);
+                out.g_rho[i0..i0 + m].fill(0.0);
+                c0 += m;
+                continue;
+            }
             let mut cell_ok = [true; L];
             if dense {
                 fill_dense(soa, ranges, i0, cols, &tests, &mut lanes);
@@ -238,11 +262,12 @@ fn fill_dense(soa: &Soa, ranges: &[f32], i0: usize, cols: usize, tests: &Tests, 
         let (qx, qy, qz, qr) = (at(&soa.x, j0), at(&soa.y, j0), at(&soa.z, j0), at(ranges, j0));
         for l in 0..L {
             let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
-            let keep = tests.keep(k, d, qr[l], pr[l]);
-            lanes.dx[k][l] = if keep { d[0] } else { 0.0 };
-            lanes.dy[k][l] = if keep { d[1] } else { 0.0 };
-            lanes.dz[k][l] = if keep { d[2] } else { 0.0 };
-            lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
+            // All ones where kept, else 0: masking the bits gives `d` or +0.0 without a branch.
+            let mask = u32::from(tests.keep(k, d, qr[l], pr[l])).wrapping_neg();
+            lanes.dx[k][l] = f32::from_bits(d[0].to_bits() & mask);
+            lanes.dy[k][l] = f32::from_bits(d[1].to_bits() & mask);
+            lanes.dz[k][l] = f32::from_bits(d[2].to_bits() & mask);
+            lanes.ok[k][l] = f32::from_bits(1f32.to_bits() & mask);
         }
     }
 }
@@ -311,18 +336,23 @@ fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f
             pairs[l] += f32::from(u8::from(iv > 0.0));
         }
     }
-    let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+    let (mut ux, mut uy, mut uz, mut good) = ([0f32; L], [0f32; L], [0f32; L], [false; L]);
     for l in 0..L {
         let sum_len = (sx[l] * sx[l] + sy[l] * sy[l] + sz[l] * sz[l]).sqrt();
-        let good = pairs[l] >= min_pairs && sum_len > 0.0 && sum_len.is_finite();
-        let (ux, uy, uz) = (sx[l] / sum_len, sy[l] / sum_len, sz[l] / sum_len);
-        // Eq. 3: mean cosine similarity between n and its generating normals.
-        let mut cos_sum = 0.0f32;
-        for k in 0..8 {
-            cos_sum += (ux * nx[k][l] + uy * ny[k][l] + uz * nz[k][l]) * inv[k][l];
+        good[l] = (pairs[l] >= min_pairs) & (sum_len > 0.0) & sum_len.is_finite();
+        (ux[l], uy[l], uz[l]) = (sx[l] / sum_len, sy[l] / sum_len, sz[l] / sum_len);
+    }
+    // Eq. 3: mean cosine similarity between n and its generating normals.
+    let mut cos_sum = [0f32; L];
+    for k in 0..8 {
+        for l in 0..L {
+            cos_sum[l] += (ux[l] * nx[k][l] + uy[l] * ny[k][l] + uz[l] * nz[k][l]) * inv[k][l];
         }
-        let q = cos_sum / pairs[l];
-        (ox[l], oy[l], oz[l], rho[l]) = if good { (ux, uy, uz, q) } else { (0.0, 0.0, 0.0, 0.0) };
+    }
+    let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+    for l in 0..L {
+        let q = cos_sum[l] / pairs[l];
+        (ox[l], oy[l], oz[l], rho[l]) = if good[l] { (ux[l], uy[l], uz[l], q) } else { (0.0, 0.0, 0.0, 0.0) };
     }
     (ox, oy, oz, rho)
 }
@@ -342,7 +372,8 @@ mod tests {
         let max_d2 = params.max_neighbour_distance_m * params.max_neighbour_distance_m;
         let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
         let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
-        let keep = [up, up, other, other, other, other, other, up];
+        let lat = factor(params.lateral_occlusion_ratio);
+        let keep = [up, up, lat, other, other, other, lat, up];
         let mut out = Vec::new();
         for r in 0..view.rows {
             for c in 0..view.cols {
@@ -471,6 +502,7 @@ mod tests {
                         max_neighbour_distance_m: 2.0,
                         occlusion_ratio: 0.1,
                         upper_occlusion_ratio: 0.05,
+                        lateral_occlusion_ratio: 0.2,
                     },
                 ),
                 (1, FeatureParams { upper_occlusion_ratio: 0.0, ..FeatureParams::default() }),
