@@ -175,6 +175,30 @@ fn an_upper_neighbour_in_front_of_the_cell_is_an_occluder() {
 }
 
 #[test]
+fn a_same_row_neighbour_in_front_of_the_cell_is_an_occluder() {
+    // Ground at (2, 20); its right neighbour in the row is on a bush 30 % nearer and 0.5 m up (the
+    // near edge of a range jump). The lateral test leaves it out; without the test it tilts the normal.
+    let sensor = SyntheticSensor::forward(6, 40, -20.0, -10.0, 40.0, 1.8);
+    let mut cloud = sensor.scan(&[flat_ground()]);
+    let (i, j) = (2 * 40 + 20, 2 * 40 + 21);
+    let q = sensor.origin + (cloud.point_in_vehicle[j] - sensor.origin) * 0.7;
+    cloud.point_in_vehicle[j] = Vec3::new(q.x, q.y, 0.5);
+    cloud.range_m[j] = (cloud.point_in_vehicle[j] - sensor.origin).length();
+    assert!(cloud.range_m[j] < 0.9 * cloud.range_m[i]);
+    let with = features(&cloud, false, FeatureParams::default());
+    assert_eq!(FeatureParams::default().lateral_occlusion_ratio, 0.1);
+    let without = features(&cloud, false, FeatureParams { lateral_occlusion_ratio: 0.0, ..Default::default() });
+    assert!(with.g_rho[i] > 0.999, "occluder left out: g_rho {}", with.g_rho[i]);
+    assert!(without.g_rho[i] < 0.9, "occluder kept: g_rho {}", without.g_rho[i]);
+    // The left neighbour, 8 % nearer than the cell (a wall seen obliquely), is kept.
+    let k = 2 * 40 + 19;
+    cloud.range_m[k] = 0.92 * cloud.range_m[i];
+    let f = features(&cloud, false, FeatureParams::default());
+    assert_eq!(f.g_rho[i], with.g_rho[i]);
+    assert!(FeatureParams { lateral_occlusion_ratio: -0.1, ..Default::default() }.validate().is_err());
+}
+
+#[test]
 fn empty_rows_of_a_merged_grid_are_skipped_up_to_max_row_gap() {
     // The merged lux-roof-4 pattern: of every 4 rows, the upper 2 have a narrower field of view, so
     // near the left and right edges rows 2, 3, 6, 7, 10, 11 are empty. Row 12 (the top ring) then
