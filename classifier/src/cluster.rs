@@ -23,6 +23,15 @@
 //! default offset is 0.15 m, the paper's 15 cm ground tolerance (0.25 m joined low vegetation to
 //! the terrain: `rural`, `lux-roof-4`, 5 frames, FPR 0.109 -> 0.071 with 0.15 m).
 //!
+//! Links that grow with range were measured and rejected (`rural` and `city`, `lux-roof-4`, 5
+//! frames, after the row-skipping neighbours and the lateral occlusion test): a radius growing by
+//! 0.01 or 0.02 m per metre of range (`link_tolerance_rel`) gave `rural` accuracy 0.934 / 0.934
+//! against 0.933 but FPR 0.051 / 0.055 against 0.047, and `city` FPR 0.003 / 0.004 against 0.002;
+//! a tangent-plane offset growing with the link length (`max(0.15 m, |d| sin a)` with a = 1, 2, 3
+//! degrees) gave `rural` accuracy 0.925, 0.905, 0.894 with FPR 0.11 to 0.17: far rings of the field
+//! lie as far from each other as from the bushes on it, so a looser link joins the bushes to the
+//! terrain. Far terrain is recovered by the extent rule (rule 4) instead.
+//!
 //! Rules (Sec. III-B), in order:
 //! 1. clusters with fewer than `min_cluster_points` points are noise: not ground;
 //! 2. the largest cluster is ground;
@@ -75,7 +84,11 @@ pub struct ClusterParams {
     pub min_large_points: usize,
     /// ... or at least this fraction of the returns, whichever is more.
     pub min_large_fraction: f32,
-    /// ... or spread over at least this x-y diagonal, metres (0 = off).
+    /// ... or spread over at least this x-y diagonal, metres (0 = off). 6 m by default: more than
+    /// the x-y diagonal of any object top that the scene library sets at ground level (a bush crown
+    /// at most 3.6 m across: 5.1 m; a car body of 4.5 m x 1.8 m: 4.85 m). Measured on `rural` with
+    /// `lux-roof-4`, 5 frames: accuracy 0.933 with 10 m, 0.938 with 7, 6 and 5 m, FPR 0.047 in all;
+    /// `city` the same with all four.
     pub min_large_extent_m: f32,
     /// Side of the squares of the ground area, metres.
     pub area_cell_m: f32,
@@ -94,7 +107,7 @@ impl Default for ClusterParams {
             min_cluster_points: 5,
             min_large_points: 100,
             min_large_fraction: 0.001,
-            min_large_extent_m: 10.0,
+            min_large_extent_m: 6.0,
             area_cell_m: 2.0,
             max_step_m: 0.5,
             near_search_m: 0.0,
