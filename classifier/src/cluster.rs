@@ -169,9 +169,20 @@ pub struct ClusterWorkspace {
     valid: Vec<bool>,
     /// Per column of the row being clustered: returns in the rows below, at and above.
     column_valid: Vec<bool>,
+    /// Cluster roots in increasing order (the per-root arrays are only read and reset there).
+    roots: Vec<u32>,
 }
 
 const NONE: u32 = u32::MAX;
+
+/// `v.floor() as isize`, bit for bit (saturating, NaN to 0), without a call to `floorf` (the
+/// baseline x86-64 target has no rounding instruction): truncation toward zero, one less where
+/// that rounded a negative value up.
+#[inline]
+fn floor_isize(v: f32) -> isize {
+    let t = v as isize;
+    if (t as f32) > v { t.saturating_sub(1) } else { t }
+}
 
 #[inline]
 fn find(parent: &mut [u32], mut i: u32) -> u32 {
@@ -284,11 +295,15 @@ pub fn cluster_candidates(
             prev_root = ri;
         }
     }
+    ws.roots.clear();
     for i in 0..n {
         if parent[i] != NONE {
             let root = find(parent, i as u32);
             parent[i] = root;
             ws.size[root as usize] += 1;
+            if root == i as u32 {
+                ws.roots.push(root);
+            }
         }
     }
 }
@@ -336,8 +351,8 @@ impl ClusterWorkspace {
             }
         }
         ground[..n].fill(false);
-        let Some((largest, _)) =
-            self.size.iter().enumerate().filter(|&(_, &s)| s > 0).max_by_key(|&(i, &s)| (s, std::cmp::Reverse(i)))
+        let size = &self.size;
+        let Some(largest) = self.roots.iter().map(|&r| r as usize).max_by_key(|&r| (size[r], std::cmp::Reverse(r)))
         else {
             return;
         };
@@ -354,9 +369,8 @@ impl ClusterWorkspace {
         let ny = (((hi.y - lo.y) / cell).floor() as usize).saturating_add(1).min(4096);
         self.area.clear();
         self.area.resize(nx * ny, (0.0, 0));
-        let square = |p: Vec3| -> (isize, isize) {
-            (((p.x - lo.x) / cell).floor() as isize, ((p.y - lo.y) / cell).floor() as isize)
-        };
+        let square =
+            |p: Vec3| -> (isize, isize) { (floor_isize((p.x - lo.x) / cell), floor_isize((p.y - lo.y) / cell)) };
         for i in 0..n {
             if self.parent[i] == largest as u32 {
                 let (x, y) = square(points[i]);
@@ -367,14 +381,18 @@ impl ClusterWorkspace {
             }
         }
         // Area test per cluster: count inside points and their height above the local ground.
-        self.inside.clear();
+        // Per-root arrays: sized once, reset at the roots only (they are read nowhere else).
+        let empty_box = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
         self.inside.resize(n, 0);
-        self.height_sum.clear();
         self.height_sum.resize(n, 0.0);
-        self.outside_sum.clear();
         self.outside_sum.resize(n, Vec3::ZERO);
-        self.bbox.clear();
-        self.bbox.resize(n, (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY)));
+        self.bbox.resize(n, empty_box);
+        self.root_ground.resize(n, false);
+        for &root in &self.roots {
+            let r = root as usize;
+            (self.inside[r], self.height_sum[r], self.outside_sum[r], self.bbox[r]) = (0, 0.0, Vec3::ZERO, empty_box);
+            self.root_ground[r] = false;
+        }
         for i in 0..n {
             let root = self.parent[i];
             if root == NONE || root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points
@@ -405,13 +423,9 @@ impl ClusterWorkspace {
         let (zsum, zcount) = self.area.iter().fold((0f64, 0u64), |(a, b), e| (a + f64::from(e.0), b + u64::from(e.1)));
         let ground_mean_z = (zsum / zcount.max(1) as f64) as f32;
         let min_large = params.min_large_points.max((params.min_large_fraction * returns as f32).ceil() as usize);
-        self.root_ground.clear();
-        self.root_ground.resize(n, false);
-        for root in 0..n {
+        for ri in 0..self.roots.len() {
+            let root = self.roots[ri] as usize;
             let size = self.size[root] as usize;
-            if size == 0 {
-                continue;
-            }
             self.root_ground[root] = if root == largest {
                 true
             } else if size < params.min_cluster_points {
@@ -533,6 +547,18 @@ mod tests {
             }
         }
         cloud
+    }
+
+    #[test]
+    fn floor_isize_equals_floor() {
+        let mut values = vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999, -2.999, 1e7, -1e7, 16_777_217.0, -8_388_609.5];
+        values.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, f32::MIN, 9.3e18, -9.3e18, -9.2e18]);
+        values.extend([f32::MIN_POSITIVE, -f32::MIN_POSITIVE, 1e-30, -1e-30]);
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(5);
+        values.extend((0..10_000).map(|_| (rng.random::<f32>() - 0.5) * 2000.0));
+        for v in values {
+            assert_eq!(floor_isize(v), v.floor() as isize, "{v}");
+        }
     }
 
     #[test]
