@@ -113,6 +113,8 @@ struct Soa {
     y: Vec<f32>,
     z: Vec<f32>,
     valid: Vec<bool>,
+    /// Per column of the row being processed: returns in the rows below, at and above.
+    column_valid: Vec<bool>,
 }
 
 impl Features {
@@ -192,14 +194,14 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     let n = rows * cols;
     out.resize(n);
     let soa = &mut out.soa;
-    soa.x.clear();
-    soa.y.clear();
-    soa.z.clear();
-    soa.valid.clear();
-    soa.x.extend(view.points[..n].iter().map(|p| p.x));
-    soa.y.extend(view.points[..n].iter().map(|p| p.y));
-    soa.z.extend(view.points[..n].iter().map(|p| p.z));
-    soa.valid.extend(view.points[..n].iter().map(|&p| is_valid(p)));
+    soa.x.resize(n, 0.0);
+    soa.y.resize(n, 0.0);
+    soa.z.resize(n, 0.0);
+    soa.valid.resize(n, false);
+    soa.column_valid.resize(cols, false);
+    for (i, p) in view.points[..n].iter().enumerate() {
+        (soa.x[i], soa.y[i], soa.z[i], soa.valid[i]) = (p.x, p.y, p.z, is_valid(*p));
+    }
     // Ratio 0 switches the test off (keep every neighbour: factor 0).
     let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
     let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
@@ -213,6 +215,13 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     let mut lanes = Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8] };
     for r in 0..rows {
         let interior_row = r > 0 && r + 1 < rows;
+        if interior_row {
+            let row = r * cols..(r + 1) * cols;
+            let (below, at, above) = (&soa.valid[row.start - cols..], &soa.valid[row.clone()], &soa.valid[row.end..]);
+            for (c, v) in soa.column_valid.iter_mut().enumerate() {
+                *v = below[c] & at[c] & above[c];
+            }
+        }
         let mut c0 = 0;
         while c0 < cols {
             let m = (cols - c0).min(L);
@@ -222,7 +231,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
                 && m == L
                 && c0 > 0
                 && c0 + L < cols
-                && [i0 - cols, i0, i0 + cols].iter().all(|&b| soa.valid[b - 1..b + L + 1].iter().all(|&v| v));
+                && soa.column_valid[c0 - 1..c0 + L + 1].iter().fold(true, |a, &v| a & v);
             if !dense && !soa.valid[i0..i0 + m].iter().any(|&v| v) {
                 // No return in these cells (sky): no features.
                 out.normal[i0..i0 + m].fill(Vec3::ZERO);

@@ -185,19 +185,20 @@ pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
     if cols < 3 || rows == 0 || points.len() < rows * cols {
         return false;
     }
-    let col_azimuth = |c: usize| -> Option<f32> {
-        let mut best: Option<(f32, Vec3)> = None;
-        for r in 0..rows {
-            let p = points[r * cols + c];
+    // The farthest return of every column (the first of equals, going up the rows), found in one
+    // pass in memory order.
+    let mut farthest: Vec<Option<(f32, Vec3)>> = vec![None; cols];
+    for row in points[..rows * cols].chunks_exact(cols) {
+        for (best, &p) in farthest.iter_mut().zip(row) {
             if is_valid(p) {
                 let d2 = p.x * p.x + p.y * p.y;
                 if best.is_none_or(|(bd, _)| d2 > bd) {
-                    best = Some((d2, p));
+                    *best = Some((d2, p));
                 }
             }
         }
-        best.map(|(_, p)| p.y.atan2(p.x))
-    };
+    }
+    let col_azimuth = |c: usize| -> Option<f32> { farthest[c].map(|(_, p)| p.y.atan2(p.x)) };
     let wrap_diff = |a: f32, b: f32| {
         let mut d = a - b;
         while d > std::f32::consts::PI {
