@@ -139,6 +139,8 @@ struct Lanes {
     dy: [[f32; L]; 8],
     dz: [[f32; L]; 8],
     ok: [[f32; L]; 8],
+    /// `|d|` per lane (0 where missing).
+    len: [[f32; L]; 8],
 }
 
 /// What the per-neighbour test needs besides the points.
@@ -153,9 +155,7 @@ impl Tests {
     // `!(a < b)` rather than `partial_cmp`: it vectorizes, and a NaN range keeps the neighbour.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
     #[inline(always)]
-    fn keep(&self, k: usize, d: [f32; 3], range_j: f32, range: f32) -> bool {
-        // glam's length_squared: (x * x + y * y) + z * z.
-        let l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    fn keep(&self, k: usize, l2: f32, range_j: f32, range: f32) -> bool {
         // Neighbours nearer than `keep[k] * range` occlude the cell (NaN ranges compare false: kept).
         // `&` rather than `&&`: no branch per lane, so the lanes vectorize.
         (l2 <= self.max_d2) & (l2 > 0.0) & !(range_j < self.keep[k] * range)
@@ -212,7 +212,8 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     };
     let min_pairs = params.min_valid_pairs as f32;
     let ranges = &view.ranges[..n];
-    let mut lanes = Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8] };
+    let mut lanes =
+        Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
     for r in 0..rows {
         let interior_row = r > 0 && r + 1 < rows;
         if interior_row {
@@ -243,6 +244,16 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
             let mut cell_ok = [true; L];
             if dense {
                 fill_dense(soa, ranges, i0, cols, &tests, &mut lanes);
+            } else if interior_row && m == L && c0 > 0 && c0 + L < cols {
+                // Some cells lack a direct neighbour: all lanes the fast way, then those cells again
+                // by the general search.
+                fill_dense(soa, ranges, i0, cols, &tests, &mut lanes);
+                let cv = &soa.column_valid[c0 - 1..c0 + L + 1];
+                for l in 0..L {
+                    if !(cv[l] & cv[l + 1] & cv[l + 2]) {
+                        cell_ok[l] = fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
+                    }
+                }
             } else {
                 for l in 0..L {
                     cell_ok[l] = l < m && fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
@@ -271,8 +282,12 @@ fn fill_dense(soa: &Soa, ranges: &[f32], i0: usize, cols: usize, tests: &Tests, 
         let (qx, qy, qz, qr) = (at(&soa.x, j0), at(&soa.y, j0), at(&soa.z, j0), at(ranges, j0));
         for l in 0..L {
             let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
+            // glam's length_squared: (x * x + y * y) + z * z.
+            let l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             // All ones where kept, else 0: masking the bits gives `d` or +0.0 without a branch.
-            let mask = u32::from(tests.keep(k, d, qr[l], pr[l])).wrapping_neg();
+            let mask = u32::from(tests.keep(k, l2, qr[l], pr[l])).wrapping_neg();
+            // The length of the masked offset: the same square root, or sqrt(+0) = +0.
+            lanes.len[k][l] = f32::from_bits(l2.to_bits() & mask).sqrt();
             lanes.dx[k][l] = f32::from_bits(d[0].to_bits() & mask);
             lanes.dy[k][l] = f32::from_bits(d[1].to_bits() & mask);
             lanes.dz[k][l] = f32::from_bits(d[2].to_bits() & mask);
@@ -300,11 +315,12 @@ fn fill_one(
         let (mut d, mut ok) = ([0.0; 3], 0.0);
         if let Some(j) = j {
             let dj = [soa.x[j] - soa.x[i], soa.y[j] - soa.y[i], soa.z[j] - soa.z[i]];
-            if tests.keep(k, dj, ranges[j], ranges[i]) {
+            if tests.keep(k, dj[0] * dj[0] + dj[1] * dj[1] + dj[2] * dj[2], ranges[j], ranges[i]) {
                 (d, ok) = (dj, 1.0);
             }
         }
         (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l], lanes.ok[k][l]) = (d[0], d[1], d[2], ok);
+        lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     }
     soa.valid[i]
 }
@@ -318,13 +334,7 @@ fn fill_one(
 /// - Eq. 2 weight `1 / (|d_i| + |d_(i-1)|)`, Eq. 3 term `(n . n_i) / |n_i|` averaged over pairs.
 #[inline(always)]
 fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
-    let (dx, dy, dz, ok) = (&d.dx, &d.dy, &d.dz, &d.ok);
-    let mut len = [[0f32; L]; 8];
-    for k in 0..8 {
-        for l in 0..L {
-            len[k][l] = (dx[k][l] * dx[k][l] + dy[k][l] * dy[k][l] + dz[k][l] * dz[k][l]).sqrt();
-        }
-    }
+    let (dx, dy, dz, ok, len) = (&d.dx, &d.dy, &d.dz, &d.ok, &d.len);
     let (mut nx, mut ny, mut nz, mut inv) = ([[0f32; L]; 8], [[0f32; L]; 8], [[0f32; L]; 8], [[0f32; L]; 8]);
     let (mut sx, mut sy, mut sz, mut pairs) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
     for k in 0..8 {
