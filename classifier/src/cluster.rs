@@ -171,6 +171,8 @@ pub struct ClusterWorkspace {
     column_valid: Vec<bool>,
     /// Cluster roots in increasing order (the per-root arrays are only read and reset there).
     roots: Vec<u32>,
+    /// Returns of the plane of the last clustering.
+    returns: usize,
 }
 
 const NONE: u32 = u32::MAX;
@@ -230,10 +232,23 @@ pub fn cluster_candidates(
     let normal = &normal[..n];
     ws.parent.clear();
     ws.parent.extend((0..n as u32).map(|i| if candidate[i as usize] { i } else { NONE }));
-    ws.size.clear();
-    ws.size.resize(n, 0);
-    ws.valid.clear();
-    ws.valid.extend(points.iter().map(|&p| is_valid(p)));
+    // Sizes are non-zero only at the last clustering's roots: reset those (no pass over all cells).
+    if ws.size.len() == n {
+        for &root in &ws.roots {
+            ws.size[root as usize] = 0;
+        }
+    } else {
+        ws.size.clear();
+        ws.size.resize(n, 0);
+    }
+    ws.valid.resize(n, false);
+    let mut returns = 0;
+    for (v, p) in ws.valid.iter_mut().zip(points) {
+        // `is_valid` without short-circuit branches, so that it vectorizes.
+        *v = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+        returns += usize::from(*v);
+    }
+    ws.returns = returns;
     // Per column of the current row: returns in the rows below, at and above.
     ws.column_valid.clear();
     ws.column_valid.resize(cols, false);
@@ -321,6 +336,11 @@ impl ClusterWorkspace {
         Some(r as usize)
     }
 
+    /// Number of returns (cells with a point) of the plane of the last [`cluster_candidates`].
+    pub fn returns(&self) -> usize {
+        self.returns
+    }
+
     /// Number of points in the cluster with root `root`.
     pub fn cluster_size(&self, root: usize) -> usize {
         self.size[root] as usize
@@ -343,17 +363,11 @@ impl ClusterWorkspace {
     /// plane into `ground` (non-candidates false). `returns` is the number of returns of the plane.
     pub fn decide(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
         let n = self.parent.len();
-        // Path-compress every candidate so parent[i] is its root.
-        for i in 0..n {
-            if self.parent[i] != NONE {
-                let r = find(&mut self.parent, i as u32);
-                self.parent[i] = r;
-            }
-        }
-        ground[..n].fill(false);
+        // Every candidate's parent is its root already ([`cluster_candidates`] compresses the paths).
         let size = &self.size;
         let Some(largest) = self.roots.iter().map(|&r| r as usize).max_by_key(|&r| (size[r], std::cmp::Reverse(r)))
         else {
+            ground[..n].fill(false);
             return;
         };
         // Ground area: squares holding points of the largest cluster, over its bounding box.

@@ -146,7 +146,7 @@ impl Nitsch {
                 &self.params.clustering,
                 &mut self.workspace,
             );
-            let returns = view.points.iter().filter(|p| is_valid(**p)).count();
+            let returns = self.workspace.returns();
             self.workspace.decide(view.points, returns, &self.params.clustering, &mut self.plane0_ground);
         } else {
             for (g, &q) in self.plane0_ground.iter_mut().zip(&self.features.g_rho) {
