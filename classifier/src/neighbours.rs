@@ -186,19 +186,21 @@ pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
         return false;
     }
     // The farthest return of every column (the first of equals, going up the rows), found in one
-    // pass in memory order.
-    let mut farthest: Vec<Option<(f32, Vec3)>> = vec![None; cols];
-    for row in points[..rows * cols].chunks_exact(cols) {
-        for (best, &p) in farthest.iter_mut().zip(row) {
-            if is_valid(p) {
-                let d2 = p.x * p.x + p.y * p.y;
-                if best.is_none_or(|(bd, _)| d2 > bd) {
-                    *best = Some((d2, p));
-                }
-            }
+    // branch-free pass in memory order: squared distances are >= 0, so -inf means none yet.
+    let mut far_d2 = vec![f32::NEG_INFINITY; cols];
+    let mut far_row = vec![0u32; cols];
+    for (r, row) in points[..rows * cols].chunks_exact(cols).enumerate() {
+        for ((bd, br), p) in far_d2.iter_mut().zip(far_row.iter_mut()).zip(row) {
+            let d2 = p.x * p.x + p.y * p.y;
+            let better = (p.x.is_finite() & p.y.is_finite() & p.z.is_finite()) & (d2 > *bd);
+            *bd = if better { d2 } else { *bd };
+            *br = if better { r as u32 } else { *br };
         }
     }
-    let col_azimuth = |c: usize| -> Option<f32> { farthest[c].map(|(_, p)| p.y.atan2(p.x)) };
+    let col_azimuth = |c: usize| -> Option<f32> {
+        let p = points[far_row[c] as usize * cols + c];
+        (far_d2[c] > f32::NEG_INFINITY).then(|| p.y.atan2(p.x))
+    };
     let wrap_diff = |a: f32, b: f32| {
         let mut d = a - b;
         while d > std::f32::consts::PI {
