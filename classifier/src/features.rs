@@ -262,13 +262,19 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
                 }
             }
             let (nx, ny, nz, rho) = lane_features(&lanes, min_pairs);
-            for l in 0..m {
-                let i = i0 + l;
-                let (n, n_rho) = if cell_ok[l] { (Vec3::new(nx[l], ny[l], nz[l]), rho[l]) } else { (Vec3::ZERO, 0.0) };
-                out.normal[i] = n;
-                out.n_rho[i] = n_rho;
-                out.g_rho[i] = n.z * n_rho;
+            // Cells without features get zeros (selects, not branches: the lanes vectorize).
+            let (mut ox, mut oy, mut oz, mut orho, mut og) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+            for l in 0..L {
+                let keep = cell_ok[l];
+                (ox[l], oy[l]) = (if keep { nx[l] } else { 0.0 }, if keep { ny[l] } else { 0.0 });
+                (oz[l], orho[l]) = (if keep { nz[l] } else { 0.0 }, if keep { rho[l] } else { 0.0 });
+                og[l] = oz[l] * orho[l];
             }
+            for (l, n) in out.normal[i0..i0 + m].iter_mut().enumerate() {
+                *n = Vec3::new(ox[l], oy[l], oz[l]);
+            }
+            out.n_rho[i0..i0 + m].copy_from_slice(&orho[..m]);
+            out.g_rho[i0..i0 + m].copy_from_slice(&og[..m]);
             c0 += m;
         }
     }
