@@ -292,7 +292,10 @@ pub fn cluster_candidates(
                     join(parent, i - 1, prev_root, &mut ri);
                 }
                 for j in [i - cols - 1, i - cols, i - cols + 1] {
-                    if parent[j] != NONE {
+                    // A parent equal to this cell's root (a root) means the same cluster already:
+                    // no search (the common case inside a surface).
+                    let pj = parent[j];
+                    if pj != NONE && pj != ri {
                         let rj = find(parent, j as u32);
                         join(parent, j, rj, &mut ri);
                     }
@@ -312,8 +315,12 @@ pub fn cluster_candidates(
     }
     ws.roots.clear();
     for i in 0..n {
-        if parent[i] != NONE {
-            let root = find(parent, i as u32);
+        let p = parent[i];
+        if p != NONE {
+            // Parents come before their children, so going up the cells the parent's own parent
+            // is usually the root already.
+            let pp = parent[p as usize];
+            let root = if parent[pp as usize] == pp { pp } else { find(parent, i as u32) };
             parent[i] = root;
             ws.size[root as usize] += 1;
             if root == i as u32 {
