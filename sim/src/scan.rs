@@ -298,6 +298,7 @@ impl<'a> Scanner<'a> {
 
         let mut extra = Vec::new();
         let mut echoes: Vec<(f32, Hit, u32)> = Vec::with_capacity(3);
+        let mut vehicle_from_world = (Affine3A::from_cols_array(&[f32::NAN; 12]), glam::Mat3A::IDENTITY);
         let row_key = RowKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32 };
         let noise = if m.range_sigma_m > 0.0 { row_key.normals(Purpose::RangeNoise, pattern.cols) } else { Vec::new() };
         for (b, &(c, f, world_from_sensor)) in beams.iter().enumerate() {
@@ -310,15 +311,32 @@ impl<'a> Scanner<'a> {
                 column: c as u32,
             };
             let centre = &rays[b * sub_rays];
-            echoes.clear();
-            for h in hits[b * sub_rays..(b + 1) * sub_rays].iter().flatten() {
-                echoes.push((h.t, *h, 1));
-            }
-            if sub_rays > 1 {
+            let single: [(f32, Hit, u32); 1];
+            let found: &[(f32, Hit, u32)] = if sub_rays == 1 {
+                match hits[b] {
+                    Some(h) => {
+                        single = [(h.t, h, 1)];
+                        &single
+                    }
+                    None => &[],
+                }
+            } else {
+                echoes.clear();
+                echoes.extend(hits[b * sub_rays..(b + 1) * sub_rays].iter().flatten().map(|h| (h.t, *h, 1)));
                 merge_echoes(&mut echoes, m.echo_separation_m);
+                &echoes
+            };
+            if found.is_empty() {
+                continue;
+            }
+            // Rotation taking world vectors to the vehicle frame at this shot (constant over a row
+            // when the vehicle stands still): vehicle_from_sensor * transpose(world_from_sensor).
+            if vehicle_from_world.0 != world_from_sensor {
+                vehicle_from_world =
+                    (world_from_sensor, vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose());
             }
             let mut echo = 0u8;
-            for &(_, hit, count) in echoes.iter() {
+            for &(_, hit, count) in found {
                 if echo >= m.max_echoes {
                     break;
                 }
@@ -337,15 +355,13 @@ impl<'a> Scanner<'a> {
                 };
                 let Some(meas) = measure(m, hit.t, cos_inc, surface.reflectivity, z) else { continue };
                 let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * meas.range_m;
-                // Rotations are orthonormal: sensor_from_world = transpose(world_from_sensor).
-                let normal_in_sensor = world_from_sensor.matrix3.transpose() * glam::Vec3A::from(n_world);
                 let cell = Cell {
                     point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
                     range_m: meas.range_m,
                     intensity: meas.intensity * count as f32 / sub_rays as f32,
                     class: surface.class,
                     instance: surface.instance,
-                    normal: Vec3::from(vehicle_from_sensor.matrix3 * normal_in_sensor).normalize_or_zero(),
+                    normal: Vec3::from(vehicle_from_world.1 * glam::Vec3A::from(n_world)),
                     sensor: s as u8,
                     ring: ring as u16,
                     column: c as u32,
