@@ -118,3 +118,18 @@ impl RigLayout {
 pub const ORDERING: &str = "row-major grid; rows sorted by ring elevation in the vehicle frame (row 0 lowest); \
 columns sorted by vehicle azimuth, decreasing (clockwise) from sensor 0's first column; columns of sensors that \
 agree within half a step are shared; uncovered cells are no-return cells; echo plane k occupies rows k*R..(k+1)*R";
+
+/// Marks a merged column that a sensor does not cover in [`RigLayout::sensor_col_of`].
+pub const NO_COLUMN: u32 = u32::MAX;
+
+impl RigLayout {
+    /// The inverse of `col_of[sensor]`: for every merged column, the sensor column that lands there,
+    /// or [`NO_COLUMN`]. (A sensor's columns never share a merged column, so the inverse exists.)
+    pub fn sensor_col_of(&self, sensor: usize) -> Vec<u32> {
+        let mut inverse = vec![NO_COLUMN; self.cols];
+        for (c, &mc) in self.col_of[sensor].iter().enumerate() {
+            inverse[mc] = c as u32;
+        }
+        inverse
+    }
+}

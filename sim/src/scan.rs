@@ -15,7 +15,7 @@ use crate::cast::{Backend, Caster, Hit, Ray};
 use crate::cloud::OrderedCloud;
 use crate::effects::{cast_limit_m, measure};
 use crate::error::{Result, SimError, check_range};
-use crate::layout::RigLayout;
+use crate::layout::{NO_COLUMN, RigLayout};
 use crate::motion::{PoseTrack, Trajectory, VehiclePose};
 use crate::noise::{BeamKey, Purpose, RowKey};
 use crate::rig::Rig;
@@ -96,6 +96,8 @@ pub struct Scanner<'a> {
     layout: RigLayout,
     /// `row_source[merged_row] = (sensor, ring)`.
     row_source: Vec<(usize, usize)>,
+    /// `sensor_col_of[sensor][merged_col]`: the sensor column in a merged column, or [`NO_COLUMN`].
+    sensor_col_of: Vec<Vec<u32>>,
     planes: usize,
     track: PoseTrack,
     frame_period_s: f64,
@@ -130,6 +132,7 @@ impl<'a> Scanner<'a> {
                 row_source[m] = (s, r);
             }
         }
+        let sensor_col_of = (0..rig.sensors.len()).map(|s| layout.sensor_col_of(s)).collect();
         let planes = measurements.iter().map(|m| usize::from(m.max_echoes.max(1))).max().unwrap_or(1);
         let frame_period_s = patterns.iter().map(|p| p.frame_period_s).fold(0.0, f64::max);
         let trajectory = Trajectory {
@@ -147,6 +150,7 @@ impl<'a> Scanner<'a> {
             vehicle_from_sensor,
             layout,
             row_source,
+            sensor_col_of,
             planes,
             track,
             frame_period_s,
@@ -204,7 +208,9 @@ impl<'a> Scanner<'a> {
     }
 
     /// Scans frame `index` into `cloud`, reusing its buffers when its shape fits (loops over many
-    /// frames avoid reallocating and page-faulting 14 MB per 128 x 2048 frame).
+    /// frames avoid reallocating and page-faulting 14 MB per 128 x 2048 frame). Every plane-0 cell is
+    /// written exactly once per frame (a return or the no-return defaults), so a reused cloud needs
+    /// no separate reset pass.
     pub fn frame_into(&self, index: usize, cloud: &mut OrderedCloud) {
         use rayon::prelude::*;
         let (rows, cols, planes) = (self.layout.rows, self.layout.cols, self.planes);
@@ -218,14 +224,14 @@ impl<'a> Scanner<'a> {
         let extra: Vec<Vec<ExtraEcho>> = if cols == 0 {
             Vec::new()
         } else {
+            // Scratch buffers are reused across the rows one worker scans; they never carry data
+            // from one row to the next (each row overwrites what it reads), so the output does not
+            // depend on how rows are split among threads.
             row_views(cloud)
                 .into_par_iter()
                 .enumerate()
-                .map(|(row, mut view)| {
-                    if !fresh {
-                        view.reset();
-                    }
-                    self.scan_row(index, start_time_s, row, &mut view)
+                .map_init(RowScratch::default, |scratch, (row, mut view)| {
+                    self.scan_row(index, start_time_s, row, &mut view, scratch)
                 })
                 .collect()
         };
@@ -239,36 +245,70 @@ impl<'a> Scanner<'a> {
     /// own time, in column order (coherent for the caster). With multi-echo sensors each beam is
     /// followed by two sub-beams at the horizontal edges of its divergence cone.
     pub fn row_rays(&self, frame: usize, row: usize) -> RowRays {
+        let mut scratch = RowScratch::default();
+        let static_pose = self.fill_row_rays(frame, row, &mut scratch);
+        let (s, ring) = self.row_source[row];
+        let beams = scratch
+            .beam_col
+            .iter()
+            .enumerate()
+            .map(|(b, &c)| {
+                let f = self.patterns[s].at(ring, c as usize).copied().unwrap_or(Firing {
+                    origin_in_sensor: Vec3::ZERO,
+                    dir_in_sensor: Vec3::ZERO,
+                    time_s: 0.0,
+                });
+                (c as usize, f, scratch.beam_pose.get(b).copied().unwrap_or(static_pose))
+            })
+            .collect();
+        RowRays { beams, rays: scratch.rays, sub_rays: scratch.sub_rays }
+    }
+
+    /// Fills `scratch` with the rays of merged row `row` (see [`Scanner::row_rays`]): `rays`,
+    /// `beam_col`, `beam_of_col`, `sub_rays` and, for a moving vehicle, `beam_pose`. Returns the
+    /// frame-start `world_from_sensor` (the pose of every beam when the vehicle stands still).
+    fn fill_row_rays(&self, frame: usize, row: usize, scratch: &mut RowScratch) -> Affine3A {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
         let vehicle_from_sensor = self.vehicle_from_sensor[s];
         let start_time_s = frame as f64 * self.frame_period_s;
         let static_world_from_sensor = self.track.frame_start(frame).world_from_vehicle() * vehicle_from_sensor;
+        let moving = !self.track.is_static();
         let t_max = cast_limit_m(m);
         let sub_rays = if m.max_echoes > 1 && m.beam_divergence_rad > 0.0 { 3 } else { 1 };
-        let mut beams = Vec::with_capacity(pattern.cols);
-        let mut rays = Vec::with_capacity(pattern.cols * sub_rays);
-        for c in 0..pattern.cols {
-            let Some(f) = pattern.at(ring, c) else { continue };
-            let world_from_sensor = if self.track.is_static() {
-                static_world_from_sensor
-            } else {
+        let off = (0.5 * m.beam_divergence_rad).tan();
+        let RowScratch { rays, beam_col, beam_pose, beam_of_col, sub_rays: scratch_sub_rays, .. } = scratch;
+        *scratch_sub_rays = sub_rays;
+        rays.clear();
+        beam_col.clear();
+        beam_pose.clear();
+        beam_of_col.clear();
+        beam_of_col.resize(pattern.cols, NO_BEAM);
+        let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
+        for (c, f) in firings.iter().enumerate() {
+            let Some(f) = f else { continue };
+            let world_from_sensor = if moving {
                 self.track.at(start_time_s + f.time_s).world_from_vehicle() * vehicle_from_sensor
+            } else {
+                static_world_from_sensor
             };
             let origin = world_from_sensor.transform_point3(f.origin_in_sensor);
             let dir = world_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
             rays.push(Ray { origin, dir, t_max });
             if sub_rays > 1 {
                 let side = world_from_sensor.transform_vector3(f.dir_in_sensor.cross(Vec3::Z)).normalize_or_zero();
-                let off = (0.5 * m.beam_divergence_rad).tan();
                 for sign in [-1.0f32, 1.0] {
                     rays.push(Ray { origin, dir: (dir + side * (sign * off)).normalize(), t_max });
                 }
             }
-            beams.push((c, *f, world_from_sensor));
+            beam_of_col[c] = beam_col.len() as u32;
+            beam_col.push(c as u32);
+            if moving {
+                beam_pose.push(world_from_sensor);
+            }
         }
-        RowRays { beams, rays, sub_rays }
+        static_world_from_sensor
     }
 
     /// Number of merged rows of every frame.
@@ -276,40 +316,52 @@ impl<'a> Scanner<'a> {
         self.layout.rows
     }
 
-    /// Scans one merged row into its plane-0 cells; returns second and later echoes.
-    fn scan_row(&self, frame: usize, start_time_s: f64, row: usize, view: &mut RowView<'_>) -> Vec<ExtraEcho> {
+    /// Scans one merged row: writes every plane-0 cell of `view` exactly once (walking the merged
+    /// columns, each either a sensor column with its return, a sensor column without one, or a
+    /// column the row's sensor does not cover); returns second and later echoes.
+    fn scan_row(
+        &self,
+        frame: usize,
+        start_time_s: f64,
+        row: usize,
+        view: &mut RowView<'_>,
+        scratch: &mut RowScratch,
+    ) -> Vec<ExtraEcho> {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
         let vehicle_from_sensor = self.vehicle_from_sensor[s];
+        let static_world_from_sensor = self.fill_row_rays(frame, row, scratch);
+        let RowScratch { rays, beam_pose, beam_of_col, hits, echoes, sub_rays, .. } = scratch;
+        let sub_rays = *sub_rays;
+        hits.clear();
+        hits.resize(rays.len(), None);
+        self.caster.cast_batch(rays, hits);
 
-        for v in view.ring.iter_mut() {
-            *v = ring as u16;
-        }
-        for c in 0..pattern.cols {
-            let mc = self.layout.col_of[s][c];
-            view.sensor[mc] = s as u8;
-            view.column[mc] = c as u32;
-            view.time[mc] = start_time_s + pattern.at(ring, c).map_or(0.0, |f| f.time_s);
-        }
-        let RowRays { beams, rays, sub_rays } = self.row_rays(frame, row);
-        let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
-        self.caster.cast_batch(&rays, &mut hits);
-
+        let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
         let mut extra = Vec::new();
-        let mut echoes: Vec<(f32, Hit, u32)> = Vec::with_capacity(3);
         let mut vehicle_from_world = (Affine3A::from_cols_array(&[f32::NAN; 12]), glam::Mat3A::IDENTITY);
         let row_key = RowKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32 };
         let noise = if m.range_sigma_m > 0.0 { row_key.normals(Purpose::RangeNoise, pattern.cols) } else { Vec::new() };
-        for (b, &(c, f, world_from_sensor)) in beams.iter().enumerate() {
-            let mc = self.layout.col_of[s][c];
-            let key = BeamKey {
-                seed: self.config.seed,
-                frame: frame as u32,
-                sensor: s as u32,
-                ring: ring as u32,
-                column: c as u32,
+        for (mc, &c) in self.sensor_col_of[s].iter().enumerate() {
+            view.ring[mc] = ring as u16;
+            if c == NO_COLUMN {
+                view.sensor[mc] = u8::MAX;
+                view.column[mc] = 0;
+                view.time[mc] = 0.0;
+                view.set_no_return(mc);
+                continue;
+            }
+            let c = c as usize;
+            view.sensor[mc] = s as u8;
+            view.column[mc] = c as u32;
+            let b = beam_of_col[c] as usize;
+            let Some(f) = firings[c].as_ref().filter(|_| b != NO_BEAM as usize) else {
+                view.time[mc] = start_time_s + 0.0;
+                view.set_no_return(mc);
+                continue;
             };
+            view.time[mc] = start_time_s + f.time_s;
             let centre = &rays[b * sub_rays];
             let single: [(f32, Hit, u32); 1];
             let found: &[(f32, Hit, u32)] = if sub_rays == 1 {
@@ -323,22 +375,20 @@ impl<'a> Scanner<'a> {
             } else {
                 echoes.clear();
                 echoes.extend(hits[b * sub_rays..(b + 1) * sub_rays].iter().flatten().map(|h| (h.t, *h, 1)));
-                merge_echoes(&mut echoes, m.echo_separation_m);
-                &echoes
+                merge_echoes(echoes, m.echo_separation_m);
+                echoes
             };
-            if found.is_empty() {
-                continue;
-            }
-            // Rotation taking world vectors to the vehicle frame at this shot (constant over a row
-            // when the vehicle stands still): vehicle_from_sensor * transpose(world_from_sensor).
-            if vehicle_from_world.0 != world_from_sensor {
-                vehicle_from_world =
-                    (world_from_sensor, vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose());
-            }
             let mut echo = 0u8;
             for &(_, hit, count) in found {
                 if echo >= m.max_echoes {
                     break;
+                }
+                // Rotation taking world vectors to the vehicle frame at this shot (constant over a
+                // row when the vehicle stands still): vehicle_from_sensor * transpose(world_from_sensor).
+                let world_from_sensor = beam_pose.get(b).copied().unwrap_or(static_world_from_sensor);
+                if vehicle_from_world.0 != world_from_sensor {
+                    vehicle_from_world =
+                        (world_from_sensor, vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose());
                 }
                 let tri = hit.triangle as usize;
                 let surface = self.mesh.surfaces[tri];
@@ -351,7 +401,14 @@ impl<'a> Scanner<'a> {
                 let z = match (echo, noise.get(c)) {
                     (0, Some(&z)) => z,
                     (0, None) => 0.0,
-                    _ => BeamKey { column: c as u32 | (u32::from(echo) << 24), ..key }.normal(Purpose::RangeNoise),
+                    _ => BeamKey {
+                        seed: self.config.seed,
+                        frame: frame as u32,
+                        sensor: s as u32,
+                        ring: ring as u32,
+                        column: c as u32 | (u32::from(echo) << 24),
+                    }
+                    .normal(Purpose::RangeNoise),
                 };
                 let Some(meas) = measure(m, hit.t, cos_inc, surface.reflectivity, z) else { continue };
                 let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * meas.range_m;
@@ -380,9 +437,34 @@ impl<'a> Scanner<'a> {
                 }
                 echo += 1;
             }
+            if echo == 0 {
+                view.set_no_return(mc);
+            }
         }
         extra
     }
+}
+
+/// Marks an unfired sensor column in [`RowScratch::beam_of_col`].
+const NO_BEAM: u32 = u32::MAX;
+
+/// Per-worker buffers for scanning one row, reused from row to row (see [`Scanner::frame_into`]).
+#[derive(Default)]
+struct RowScratch {
+    /// The row's rays, `sub_rays` per fired beam.
+    rays: Vec<Ray>,
+    /// Rays per beam.
+    sub_rays: usize,
+    /// Sensor column of each fired beam.
+    beam_col: Vec<u32>,
+    /// `world_from_sensor` of each fired beam at its shot time (moving vehicle only, else empty).
+    beam_pose: Vec<Affine3A>,
+    /// Beam index of each sensor column, [`NO_BEAM`] where the sensor does not fire.
+    beam_of_col: Vec<u32>,
+    /// Hit of each ray.
+    hits: Vec<Option<Hit>>,
+    /// Echoes of one multi-echo beam.
+    echoes: Vec<(f32, Hit, u32)>,
 }
 
 /// Groups sub-beam hits (sorted by distance) into echoes at least `separation_m` apart; keeps the
@@ -466,19 +548,17 @@ struct RowView<'c> {
 }
 
 impl RowView<'_> {
-    /// Sets every cell of the row to a no-return cell (as [`OrderedCloud::empty`] does).
-    fn reset(&mut self) {
-        self.point.fill(Vec3::NAN);
-        self.range.fill(f32::NAN);
-        self.intensity.fill(0.0);
-        self.ring.fill(0);
-        self.column.fill(0);
-        self.sensor.fill(u8::MAX);
-        self.time.fill(0.0);
-        self.label.fill(SemanticClass::UNLABELED);
-        self.instance.fill(0);
-        self.ground.fill(false);
-        self.normal.fill(Vec3::ZERO);
+    /// Writes the no-return defaults of the return fields of cell `i` (as [`OrderedCloud::empty`]
+    /// makes them); ring, column, sensor and time are the caller's.
+    #[inline]
+    fn set_no_return(&mut self, i: usize) {
+        self.point[i] = Vec3::NAN;
+        self.range[i] = f32::NAN;
+        self.intensity[i] = 0.0;
+        self.label[i] = SemanticClass::UNLABELED;
+        self.instance[i] = 0;
+        self.ground[i] = false;
+        self.normal[i] = Vec3::ZERO;
     }
 }
 
