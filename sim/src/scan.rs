@@ -19,7 +19,7 @@ use crate::layout::{NO_COLUMN, RigLayout};
 use crate::motion::{PoseTrack, Trajectory, VehiclePose};
 use crate::noise::{BeamKey, Purpose, RowKey};
 use crate::rig::Rig;
-use crate::scene::{SceneMesh, SemanticClass};
+use crate::scene::{SceneMesh, SemanticClass, Surface};
 use crate::sensor::{Firing, Measurement, ScanPattern};
 
 /// Largest number of frames one scan may produce.
@@ -89,7 +89,8 @@ pub struct Frame {
 pub struct Scanner<'a> {
     mesh: &'a SceneMesh,
     caster: Box<dyn Caster>,
-    normals: Vec<Vec3>,
+    /// Per triangle, its world normal and surface record side by side (one cache miss per hit, not two).
+    triangles: Vec<TriangleRecord>,
     patterns: Vec<ScanPattern>,
     measurements: Vec<Measurement>,
     vehicle_from_sensor: Vec<Affine3A>,
@@ -98,6 +99,8 @@ pub struct Scanner<'a> {
     row_source: Vec<(usize, usize)>,
     /// `sensor_col_of[sensor][merged_col]`: the sensor column in a merged column, or [`NO_COLUMN`].
     sensor_col_of: Vec<Vec<u32>>,
+    /// For a standing vehicle, every merged row's beams and rays (the same in every frame), built once.
+    static_beams: Option<Vec<RowBeams>>,
     planes: usize,
     track: PoseTrack,
     frame_period_s: f64,
@@ -117,7 +120,9 @@ impl<'a> Scanner<'a> {
         rig.validate()?;
         mesh.validate().map_err(|m| SimError::invalid("scene mesh", m, "finite vertices, valid indices"))?;
         let caster = config.backend.build(mesh);
-        let normals = (0..mesh.len()).map(|i| mesh.triangle_normal(i)).collect();
+        let triangles = (0..mesh.len())
+            .map(|i| TriangleRecord { normal_in_world: mesh.triangle_normal(i), surface: mesh.surfaces[i] })
+            .collect();
         let patterns: Vec<ScanPattern> = rig.sensors.iter().map(|s| s.spec.pattern()).collect();
         let measurements: Vec<Measurement> = rig
             .sensors
@@ -141,10 +146,10 @@ impl<'a> Scanner<'a> {
         };
         let track =
             PoseTrack::new(caster.as_ref(), trajectory, frame_period_s, config.frames, f64::from(config.ego_z_m));
-        Ok(Self {
+        let mut scanner = Self {
             mesh,
             caster,
-            normals,
+            triangles,
             patterns,
             measurements,
             vehicle_from_sensor,
@@ -155,7 +160,24 @@ impl<'a> Scanner<'a> {
             track,
             frame_period_s,
             config,
-        })
+            static_beams: None,
+        };
+        if scanner.track.is_static() {
+            let cached = (0..scanner.layout.rows)
+                .map(|row| {
+                    let mut beams = RowBeams::default();
+                    scanner.fill_row_beams(0, row, &mut beams);
+                    beams
+                })
+                .collect();
+            scanner.static_beams = Some(cached);
+        }
+        Ok(scanner)
+    }
+
+    /// The scene being scanned.
+    pub fn mesh(&self) -> &'a SceneMesh {
+        self.mesh
     }
 
     /// The rig's merged grid layout.
@@ -245,10 +267,10 @@ impl<'a> Scanner<'a> {
     /// own time, in column order (coherent for the caster). With multi-echo sensors each beam is
     /// followed by two sub-beams at the horizontal edges of its divergence cone.
     pub fn row_rays(&self, frame: usize, row: usize) -> RowRays {
-        let mut scratch = RowScratch::default();
-        let static_pose = self.fill_row_rays(frame, row, &mut scratch);
+        let mut row_beams = RowBeams::default();
+        self.fill_row_beams(frame, row, &mut row_beams);
         let (s, ring) = self.row_source[row];
-        let beams = scratch
+        let beams = row_beams
             .beam_col
             .iter()
             .enumerate()
@@ -258,16 +280,15 @@ impl<'a> Scanner<'a> {
                     dir_in_sensor: Vec3::ZERO,
                     time_s: 0.0,
                 });
-                (c as usize, f, scratch.beam_pose.get(b).copied().unwrap_or(static_pose))
+                (c as usize, f, row_beams.beam_pose.get(b).copied().unwrap_or(row_beams.static_pose))
             })
             .collect();
-        RowRays { beams, rays: scratch.rays, sub_rays: scratch.sub_rays }
+        RowRays { beams, rays: row_beams.rays, sub_rays: row_beams.sub_rays }
     }
 
-    /// Fills `scratch` with the rays of merged row `row` (see [`Scanner::row_rays`]): `rays`,
-    /// `beam_col`, `beam_of_col`, `sub_rays` and, for a moving vehicle, `beam_pose`. Returns the
-    /// frame-start `world_from_sensor` (the pose of every beam when the vehicle stands still).
-    fn fill_row_rays(&self, frame: usize, row: usize, scratch: &mut RowScratch) -> Affine3A {
+    /// Fills `out` with the beams and rays of merged row `row` in frame `frame` (see
+    /// [`Scanner::row_rays`]).
+    fn fill_row_beams(&self, frame: usize, row: usize, out: &mut RowBeams) {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
@@ -278,8 +299,9 @@ impl<'a> Scanner<'a> {
         let t_max = cast_limit_m(m);
         let sub_rays = if m.max_echoes > 1 && m.beam_divergence_rad > 0.0 { 3 } else { 1 };
         let off = (0.5 * m.beam_divergence_rad).tan();
-        let RowScratch { rays, beam_col, beam_pose, beam_of_col, sub_rays: scratch_sub_rays, .. } = scratch;
-        *scratch_sub_rays = sub_rays;
+        let RowBeams { rays, beam_col, beam_pose, beam_of_col, sub_rays: out_sub_rays, static_pose } = out;
+        *out_sub_rays = sub_rays;
+        *static_pose = static_world_from_sensor;
         rays.clear();
         beam_col.clear();
         beam_pose.clear();
@@ -308,7 +330,6 @@ impl<'a> Scanner<'a> {
                 beam_pose.push(world_from_sensor);
             }
         }
-        static_world_from_sensor
     }
 
     /// Number of merged rows of every frame.
@@ -331,16 +352,28 @@ impl<'a> Scanner<'a> {
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
         let vehicle_from_sensor = self.vehicle_from_sensor[s];
-        let static_world_from_sensor = self.fill_row_rays(frame, row, scratch);
-        let RowScratch { rays, beam_pose, beam_of_col, hits, echoes, sub_rays, .. } = scratch;
-        let sub_rays = *sub_rays;
+        let RowScratch { beams, hits, echoes } = scratch;
+        let beams = match &self.static_beams {
+            Some(cached) => &cached[row],
+            None => {
+                self.fill_row_beams(frame, row, beams);
+                beams
+            }
+        };
+        let RowBeams { rays, beam_pose, beam_of_col, sub_rays, static_pose: static_world_from_sensor, .. } = beams;
+        let (sub_rays, static_world_from_sensor) = (*sub_rays, *static_world_from_sensor);
         hits.clear();
         hits.resize(rays.len(), None);
         self.caster.cast_batch(rays, hits);
 
         let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
         let mut extra = Vec::new();
-        let mut vehicle_from_world = (Affine3A::from_cols_array(&[f32::NAN; 12]), glam::Mat3A::IDENTITY);
+        // Rotation taking world vectors to the vehicle frame at a shot: vehicle_from_sensor *
+        // transpose(world_from_sensor). Constant over the row when the vehicle stands still, else
+        // recomputed when the shot's pose changes.
+        let rotation =
+            |world_from_sensor: Affine3A| vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose();
+        let mut vehicle_from_world = (static_world_from_sensor, rotation(static_world_from_sensor));
         let row_key = RowKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32 };
         let noise = if m.range_sigma_m > 0.0 { row_key.normals(Purpose::RangeNoise, pattern.cols) } else { Vec::new() };
         for (mc, &c) in self.sensor_col_of[s].iter().enumerate() {
@@ -383,16 +416,13 @@ impl<'a> Scanner<'a> {
                 if echo >= m.max_echoes {
                     break;
                 }
-                // Rotation taking world vectors to the vehicle frame at this shot (constant over a
-                // row when the vehicle stands still): vehicle_from_sensor * transpose(world_from_sensor).
-                let world_from_sensor = beam_pose.get(b).copied().unwrap_or(static_world_from_sensor);
-                if vehicle_from_world.0 != world_from_sensor {
-                    vehicle_from_world =
-                        (world_from_sensor, vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose());
+                if let Some(&world_from_sensor) = beam_pose.get(b)
+                    && vehicle_from_world.0 != world_from_sensor
+                {
+                    vehicle_from_world = (world_from_sensor, rotation(world_from_sensor));
                 }
                 let tri = hit.triangle as usize;
-                let surface = self.mesh.surfaces[tri];
-                let mut n_world = self.normals[tri];
+                let TriangleRecord { normal_in_world: mut n_world, surface } = self.triangles[tri];
                 if n_world.dot(centre.dir) > 0.0 {
                     n_world = -n_world;
                 }
@@ -415,7 +445,12 @@ impl<'a> Scanner<'a> {
                 let cell = Cell {
                     point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
                     range_m: meas.range_m,
-                    intensity: meas.intensity * count as f32 / sub_rays as f32,
+                    // (Exact when one sub-ray: x * 1 / 1 == x.)
+                    intensity: if sub_rays == 1 {
+                        meas.intensity
+                    } else {
+                        meas.intensity * count as f32 / sub_rays as f32
+                    },
                     class: surface.class,
                     instance: surface.instance,
                     normal: Vec3::from(vehicle_from_world.1 * glam::Vec3A::from(n_world)),
@@ -445,12 +480,21 @@ impl<'a> Scanner<'a> {
     }
 }
 
+/// What the effects need of a triangle that was hit.
+#[derive(Clone, Copy, Debug)]
+struct TriangleRecord {
+    /// Unit normal, world frame (front side).
+    normal_in_world: Vec3,
+    /// The triangle's surface record.
+    surface: Surface,
+}
+
 /// Marks an unfired sensor column in [`RowScratch::beam_of_col`].
 const NO_BEAM: u32 = u32::MAX;
 
-/// Per-worker buffers for scanning one row, reused from row to row (see [`Scanner::frame_into`]).
-#[derive(Default)]
-struct RowScratch {
+/// The beams of one merged row and their rays (see [`Scanner::row_rays`]).
+#[derive(Clone, Debug, Default)]
+struct RowBeams {
     /// The row's rays, `sub_rays` per fired beam.
     rays: Vec<Ray>,
     /// Rays per beam.
@@ -459,8 +503,17 @@ struct RowScratch {
     beam_col: Vec<u32>,
     /// `world_from_sensor` of each fired beam at its shot time (moving vehicle only, else empty).
     beam_pose: Vec<Affine3A>,
+    /// `world_from_sensor` at the start of the frame: the pose of every beam of a standing vehicle.
+    static_pose: Affine3A,
     /// Beam index of each sensor column, [`NO_BEAM`] where the sensor does not fire.
     beam_of_col: Vec<u32>,
+}
+
+/// Per-worker buffers for scanning one row, reused from row to row (see [`Scanner::frame_into`]).
+#[derive(Default)]
+struct RowScratch {
+    /// The row's beams when they are not cached (moving vehicle).
+    beams: RowBeams,
     /// Hit of each ray.
     hits: Vec<Option<Hit>>,
     /// Echoes of one multi-echo beam.
