@@ -91,6 +91,8 @@ pub struct Scanner<'a> {
     caster: Box<dyn Caster>,
     /// Per triangle, its world normal and surface record side by side (one cache miss per hit, not two).
     triangles: Vec<TriangleRecord>,
+    /// The scene's distinct surface records, indexed by [`TriangleRecord::surface`].
+    surfaces: Vec<Surface>,
     patterns: Vec<ScanPattern>,
     measurements: Vec<Measurement>,
     vehicle_from_sensor: Vec<Affine3A>,
@@ -120,9 +122,7 @@ impl<'a> Scanner<'a> {
         rig.validate()?;
         mesh.validate().map_err(|m| SimError::invalid("scene mesh", m, "finite vertices, valid indices"))?;
         let caster = config.backend.build(mesh);
-        let triangles = (0..mesh.len())
-            .map(|i| TriangleRecord { normal_in_world: mesh.triangle_normal(i), surface: mesh.surfaces[i] })
-            .collect();
+        let (triangles, surfaces) = triangle_records(mesh);
         let patterns: Vec<ScanPattern> = rig.sensors.iter().map(|s| s.spec.pattern()).collect();
         let measurements: Vec<Measurement> = rig
             .sensors
@@ -150,6 +150,7 @@ impl<'a> Scanner<'a> {
             mesh,
             caster,
             triangles,
+            surfaces,
             patterns,
             measurements,
             vehicle_from_sensor,
@@ -350,7 +351,9 @@ impl<'a> Scanner<'a> {
     ) -> Vec<ExtraEcho> {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
-        let m = &self.measurements[s];
+        // A local copy: its fields are loop invariants the compiler can hoist (through a reference it
+        // must assume the cell writes may change them).
+        let m = &{ self.measurements[s] };
         let vehicle_from_sensor = self.vehicle_from_sensor[s];
         let RowScratch { beams, hits, echoes } = scratch;
         let beams = match &self.static_beams {
@@ -360,7 +363,8 @@ impl<'a> Scanner<'a> {
                 beams
             }
         };
-        let RowBeams { rays, beam_pose, beam_of_col, sub_rays, static_pose: static_world_from_sensor, .. } = beams;
+        let RowBeams { rays, beam_pose, beam_of_col, sub_rays, static_pose: static_world_from_sensor, beam_col } =
+            beams;
         let (sub_rays, static_world_from_sensor) = (*sub_rays, *static_world_from_sensor);
         hits.clear();
         hits.resize(rays.len(), None);
@@ -375,7 +379,15 @@ impl<'a> Scanner<'a> {
             |world_from_sensor: Affine3A| vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose();
         let mut vehicle_from_world = (static_world_from_sensor, rotation(static_world_from_sensor));
         let row_key = RowKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32 };
-        let noise = if m.range_sigma_m > 0.0 { row_key.normals(Purpose::RangeNoise, pattern.cols) } else { Vec::new() };
+        // The row stream's draws for columns 0 ..= the last column with a hit: a prefix of the full
+        // row stream, so the same numbers as drawing all columns (rows that hit nothing, e.g. beams
+        // pointing at the sky, draw nothing).
+        let noise = match hits.iter().rposition(Option::is_some) {
+            Some(last) if m.range_sigma_m > 0.0 => {
+                row_key.normals(Purpose::RangeNoise, beam_col[last / sub_rays] as usize + 1)
+            }
+            _ => Vec::new(),
+        };
         for (mc, &c) in self.sensor_col_of[s].iter().enumerate() {
             view.ring[mc] = ring as u16;
             if c == NO_COLUMN {
@@ -423,6 +435,7 @@ impl<'a> Scanner<'a> {
                 }
                 let tri = hit.triangle as usize;
                 let TriangleRecord { normal_in_world: mut n_world, surface } = self.triangles[tri];
+                let surface = self.surfaces[surface as usize];
                 if n_world.dot(centre.dir) > 0.0 {
                     n_world = -n_world;
                 }
@@ -480,13 +493,32 @@ impl<'a> Scanner<'a> {
     }
 }
 
-/// What the effects need of a triangle that was hit.
+/// What the effects need of a triangle that was hit, in 16 bytes (four to a cache line: the hit
+/// triangles of a frame are scattered over the mesh, so these loads mostly miss the cache).
 #[derive(Clone, Copy, Debug)]
 struct TriangleRecord {
     /// Unit normal, world frame (front side).
     normal_in_world: Vec3,
-    /// The triangle's surface record.
-    surface: Surface,
+    /// Index of the triangle's surface record in the table of distinct surfaces.
+    surface: u32,
+}
+
+/// Every triangle's record and the table of the scene's distinct surfaces (scenes have few: one
+/// per class and object instance).
+fn triangle_records(mesh: &SceneMesh) -> (Vec<TriangleRecord>, Vec<Surface>) {
+    let mut surfaces: Vec<Surface> = Vec::new();
+    let mut index_of: std::collections::HashMap<(u16, u32, u32), u32> = std::collections::HashMap::new();
+    let records = (0..mesh.len())
+        .map(|i| {
+            let sf = mesh.surfaces[i];
+            let surface = *index_of.entry((sf.class.0, sf.instance, sf.reflectivity.to_bits())).or_insert_with(|| {
+                surfaces.push(sf);
+                (surfaces.len() - 1) as u32
+            });
+            TriangleRecord { normal_in_world: mesh.triangle_normal(i), surface }
+        })
+        .collect();
+    (records, surfaces)
 }
 
 /// Marks an unfired sensor column in [`RowScratch::beam_of_col`].
