@@ -366,7 +366,7 @@ impl<'a> Scanner<'a> {
         let RowBeams { rays, beam_pose, beam_of_col, sub_rays, static_pose: static_world_from_sensor, beam_col } =
             beams;
         let (sub_rays, static_world_from_sensor) = (*sub_rays, *static_world_from_sensor);
-        hits.clear();
+        // No clearing: `cast_batch` writes every entry (its contract), so only new entries are filled.
         hits.resize(rays.len(), None);
         self.caster.cast_batch(rays, hits);
 
@@ -407,39 +407,24 @@ impl<'a> Scanner<'a> {
                 continue;
             };
             view.time[mc] = start_time_s + f.time_s;
-            let centre = &rays[b * sub_rays];
-            let single: [(f32, Hit, u32); 1];
-            let found: &[(f32, Hit, u32)] = if sub_rays == 1 {
-                match hits[b] {
-                    Some(h) => {
-                        single = [(h.t, h, 1)];
-                        &single
-                    }
-                    None => &[],
-                }
-            } else {
-                echoes.clear();
-                echoes.extend(hits[b * sub_rays..(b + 1) * sub_rays].iter().flatten().map(|h| (h.t, *h, 1)));
-                merge_echoes(echoes, m.echo_separation_m);
-                echoes
-            };
-            let mut echo = 0u8;
-            for &(_, hit, count) in found {
-                if echo >= m.max_echoes {
-                    break;
-                }
-                if let Some(&world_from_sensor) = beam_pose.get(b)
-                    && vehicle_from_world.0 != world_from_sensor
-                {
-                    vehicle_from_world = (world_from_sensor, rotation(world_from_sensor));
-                }
-                let tri = hit.triangle as usize;
-                let TriangleRecord { normal_in_world: mut n_world, surface } = self.triangles[tri];
+            let centre_dir = rays[b * sub_rays].dir;
+            let any_hit = hits[b * sub_rays..(b + 1) * sub_rays].iter().any(Option::is_some);
+            if any_hit
+                && let Some(&world_from_sensor) = beam_pose.get(b)
+                && vehicle_from_world.0 != world_from_sensor
+            {
+                vehicle_from_world = (world_from_sensor, rotation(world_from_sensor));
+            }
+            let vehicle_from_world = vehicle_from_world.1;
+            // The cell of a hit of this beam reported as echo `echo` by `count` of its sub-rays, or
+            // `None` when the sensor reports nothing.
+            let hit_cell = |hit: Hit, count: u32, echo: u8| {
+                let TriangleRecord { normal_in_world: mut n_world, surface } = self.triangles[hit.triangle as usize];
                 let surface = self.surfaces[surface as usize];
-                if n_world.dot(centre.dir) > 0.0 {
+                if n_world.dot(centre_dir) > 0.0 {
                     n_world = -n_world;
                 }
-                let cos_inc = -n_world.dot(centre.dir);
+                let cos_inc = -n_world.dot(centre_dir);
                 // First echoes use the row stream; later echoes (rare) their own keyed stream.
                 let z = match (echo, noise.get(c)) {
                     (0, Some(&z)) => z,
@@ -453,9 +438,9 @@ impl<'a> Scanner<'a> {
                     }
                     .normal(Purpose::RangeNoise),
                 };
-                let Some(meas) = measure(m, hit.t, cos_inc, surface.reflectivity, z) else { continue };
+                let meas = measure(m, hit.t, cos_inc, surface.reflectivity, z)?;
                 let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * meas.range_m;
-                let cell = Cell {
+                Some(Cell {
                     point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
                     range_m: meas.range_m,
                     // (Exact when one sub-ray: x * 1 / 1 == x.)
@@ -466,13 +451,38 @@ impl<'a> Scanner<'a> {
                     },
                     class: surface.class,
                     instance: surface.instance,
-                    normal: Vec3::from(vehicle_from_world.1 * glam::Vec3A::from(n_world)),
+                    normal: Vec3::from(vehicle_from_world * glam::Vec3A::from(n_world)),
                     sensor: s as u8,
                     ring: ring as u16,
                     column: c as u32,
                     time_s: start_time_s + f.time_s,
-                };
-                if echo == 0 {
+                })
+            };
+            let first = if sub_rays == 1 {
+                // One ray per beam: at most one echo.
+                hits[b].filter(|_| m.max_echoes > 0).and_then(|h| hit_cell(h, 1, 0))
+            } else {
+                echoes.clear();
+                echoes.extend(hits[b * sub_rays..(b + 1) * sub_rays].iter().flatten().map(|h| (h.t, *h, 1)));
+                merge_echoes(echoes, m.echo_separation_m);
+                let mut first = None;
+                let mut echo = 0u8;
+                for &(_, hit, count) in echoes.iter() {
+                    if echo >= m.max_echoes {
+                        break;
+                    }
+                    let Some(cell) = hit_cell(hit, count, echo) else { continue };
+                    if echo == 0 {
+                        first = Some(cell);
+                    } else {
+                        extra.push(ExtraEcho { row, col: mc, echo, cell });
+                    }
+                    echo += 1;
+                }
+                first
+            };
+            match first {
+                Some(cell) => {
                     view.point[mc] = cell.point_in_vehicle;
                     view.range[mc] = cell.range_m;
                     view.intensity[mc] = cell.intensity;
@@ -480,13 +490,8 @@ impl<'a> Scanner<'a> {
                     view.instance[mc] = cell.instance;
                     view.ground[mc] = cell.class.is_ground();
                     view.normal[mc] = cell.normal;
-                } else {
-                    extra.push(ExtraEcho { row, col: mc, echo, cell });
                 }
-                echo += 1;
-            }
-            if echo == 0 {
-                view.set_no_return(mc);
+                None => view.set_no_return(mc),
             }
         }
         extra
