@@ -133,13 +133,14 @@ const L: usize = 16;
 /// Grid offsets `(row, col)` of `d1..d8` (see [`crate::neighbours`]).
 const OFFSETS: [(isize, isize); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
 
-/// Neighbour offsets of `L` cells, lane-wise: `dx[k][l]` is `d_(k+1)` of lane `l` (0 where missing).
+/// Neighbour offsets of `L` cells, lane-wise: `dx[k][l]` is `d_(k+1)` of lane `l` (0 where missing in
+/// the general path; `ok` 0 marks a dropped neighbour).
 struct Lanes {
     dx: [[f32; L]; 8],
     dy: [[f32; L]; 8],
     dz: [[f32; L]; 8],
     ok: [[f32; L]; 8],
-    /// `|d|` per lane (0 where missing).
+    /// `|d|` per lane (0 where missing in the general path; any finite value where `ok` is 0).
     len: [[f32; L]; 8],
 }
 
@@ -309,14 +310,10 @@ fn fill_dense(soa: &Soa, ranges: &[f32], i0: usize, cols: usize, tests: &Tests, 
             let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
             // glam's length_squared: (x * x + y * y) + z * z.
             let l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            // All ones where kept, else 0: masking the bits gives `d` or +0.0 without a branch.
-            let mask = u32::from(tests.keep(k, l2, qr[l], pr[l])).wrapping_neg();
-            // The length of the masked offset: the same square root, or sqrt(+0) = +0.
-            lanes.len[k][l] = f32::from_bits(l2.to_bits() & mask).sqrt();
-            lanes.dx[k][l] = f32::from_bits(d[0].to_bits() & mask);
-            lanes.dy[k][l] = f32::from_bits(d[1].to_bits() & mask);
-            lanes.dz[k][l] = f32::from_bits(d[2].to_bits() & mask);
-            lanes.ok[k][l] = f32::from_bits(1f32.to_bits() & mask);
+            // A dropped neighbour keeps its (finite) offset: `ok` 0 gives its pairs weight 0.
+            lanes.ok[k][l] = if tests.keep(k, l2, qr[l], pr[l]) { 1.0 } else { 0.0 };
+            (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
+            lanes.len[k][l] = l2.sqrt();
         }
     }
 }
@@ -374,14 +371,16 @@ fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f
             let nl2 = x * x + y * y + z * z;
             // `|n_i| > 1e-12 |d_i| |d_(i-1)|`, squared (no square root).
             let (lk, lp) = (len[k][l], len[p][l]);
-            let valid = ok[k][l] * ok[p][l] * f32::from(u8::from(nl2 > 1e-24 * (lk * lk) * (lp * lp)));
+            let t = lk * lp;
+            // 1 where the pair exists, else 0 (a select, not a conversion).
+            let valid = if nl2 > 1e-24 * t * t { ok[k][l] * ok[p][l] } else { 0.0 };
             let iv = valid * rsqrt(nl2.max(f32::MIN_POSITIVE));
             let w = valid / (lk + lp).max(f32::MIN_POSITIVE);
             (nx[k][l], ny[k][l], nz[k][l], inv[k][l]) = (x, y, z, iv);
             sx[l] += x * w;
             sy[l] += y * w;
             sz[l] += z * w;
-            pairs[l] += f32::from(u8::from(iv > 0.0));
+            pairs[l] += valid;
         }
     }
     let (mut ux, mut uy, mut uz, mut good) = ([0f32; L], [0f32; L], [0f32; L], [false; L]);
