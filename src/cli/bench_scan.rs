@@ -1,5 +1,10 @@
 //! `groundtruth bench scan`: what a full frame (rays, casting, effects, labels, ordered cloud) costs
 //! against casting the same rays bare. Prints one JSON object.
+//!
+//! Bare: the frame's rays, generated beforehand, cast with `cast_batch` per row in parallel. Full:
+//! `Scanner::frame_into` into a reused cloud. A standing vehicle's rays are the same in every frame,
+//! so the scanner builds them once (in `Scanner::new`); `--speed` makes the vehicle move so that
+//! every full frame builds its rays at each shot's own pose.
 
 use std::time::Instant;
 
@@ -25,6 +30,9 @@ pub struct Args {
     /// Scene seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Ego speed, metres per second (0: a standing vehicle).
+    #[arg(long, default_value_t = 0.0)]
+    pub speed: f32,
 }
 
 /// Runs the benchmark.
@@ -42,7 +50,7 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;
     let t0 = Instant::now();
-    let config = ScanConfig { ego_z_m: scene.ego_ground_z_m, ..ScanConfig::default() };
+    let config = ScanConfig { ego_z_m: scene.ego_ground_z_m, speed_m_per_s: args.speed, ..ScanConfig::default() };
     let scanner = Scanner::new(&scene.mesh, &rig, config)?;
     let setup_s = t0.elapsed().as_secs_f64();
 
@@ -73,6 +81,7 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
         "rig": args.rig,
         "triangles": scene.mesh.len(),
         "threads": rayon::current_num_threads(),
+        "speed_m_per_s": args.speed,
         "rays": rays,
         "returns": cloud.returns(),
         "setup_s": setup_s,
