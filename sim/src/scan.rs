@@ -101,6 +101,8 @@ pub struct Scanner<'a> {
     row_source: Vec<(usize, usize)>,
     /// `sensor_col_of[sensor][merged_col]`: the sensor column in a merged column, or [`NO_COLUMN`].
     sensor_col_of: Vec<Vec<u32>>,
+    /// Each sensor's distinct shot times.
+    shot_times: Vec<ShotTimes>,
     /// For a standing vehicle, every merged row's beams and rays (the same in every frame), built once.
     static_beams: Option<Vec<RowBeams>>,
     planes: usize,
@@ -124,6 +126,7 @@ impl<'a> Scanner<'a> {
         let caster = config.backend.build(mesh);
         let (triangles, surfaces) = triangle_records(mesh);
         let patterns: Vec<ScanPattern> = rig.sensors.iter().map(|s| s.spec.pattern()).collect();
+        let shot_times = patterns.iter().map(ShotTimes::new).collect();
         let measurements: Vec<Measurement> = rig
             .sensors
             .iter()
@@ -162,12 +165,13 @@ impl<'a> Scanner<'a> {
             frame_period_s,
             config,
             static_beams: None,
+            shot_times,
         };
         if scanner.track.is_static() {
             let cached = (0..scanner.layout.rows)
                 .map(|row| {
                     let mut beams = RowBeams::default();
-                    scanner.fill_row_beams(0, row, &mut beams);
+                    scanner.fill_row_beams(0, row, &mut beams, None);
                     beams
                 })
                 .collect();
@@ -244,6 +248,21 @@ impl<'a> Scanner<'a> {
             cloud.reset_cells(rows * cols..cloud.len());
         }
         let start_time_s = index as f64 * self.frame_period_s;
+        // A moving vehicle's pose at each distinct shot time of each sensor, computed once per frame
+        // (many beams share a shot time: all lasers of an OS1 column fire together).
+        let shot_poses: Option<Vec<Vec<Affine3A>>> = (!self.track.is_static()).then(|| {
+            self.shot_times
+                .iter()
+                .zip(&self.vehicle_from_sensor)
+                .map(|(shots, &vehicle_from_sensor)| {
+                    shots
+                        .times
+                        .par_iter()
+                        .map(|&t| self.track.at(start_time_s + t).world_from_vehicle() * vehicle_from_sensor)
+                        .collect()
+                })
+                .collect()
+        });
         let extra: Vec<Vec<ExtraEcho>> = if cols == 0 {
             Vec::new()
         } else {
@@ -254,7 +273,7 @@ impl<'a> Scanner<'a> {
                 .into_par_iter()
                 .enumerate()
                 .map_init(RowScratch::default, |scratch, (row, mut view)| {
-                    self.scan_row(index, start_time_s, row, &mut view, scratch)
+                    self.scan_row(index, start_time_s, row, &mut view, scratch, shot_poses.as_deref())
                 })
                 .collect()
         };
@@ -269,7 +288,7 @@ impl<'a> Scanner<'a> {
     /// followed by two sub-beams at the horizontal edges of its divergence cone.
     pub fn row_rays(&self, frame: usize, row: usize) -> RowRays {
         let mut row_beams = RowBeams::default();
-        self.fill_row_beams(frame, row, &mut row_beams);
+        self.fill_row_beams(frame, row, &mut row_beams, None);
         let (s, ring) = self.row_source[row];
         let beams = row_beams
             .beam_col
@@ -289,7 +308,10 @@ impl<'a> Scanner<'a> {
 
     /// Fills `out` with the beams and rays of merged row `row` in frame `frame` (see
     /// [`Scanner::row_rays`]).
-    fn fill_row_beams(&self, frame: usize, row: usize, out: &mut RowBeams) {
+    /// `shot_poses` (per sensor, indexed like [`ShotTimes::times`]) are the frame's
+    /// `world_from_sensor` at each distinct shot time of a moving vehicle; `None` computes each
+    /// beam's pose on the spot.
+    fn fill_row_beams(&self, frame: usize, row: usize, out: &mut RowBeams, shot_poses: Option<&[Vec<Affine3A>]>) {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
@@ -309,10 +331,14 @@ impl<'a> Scanner<'a> {
         beam_of_col.clear();
         beam_of_col.resize(pattern.cols, NO_BEAM);
         let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
+        let shot_of = &self.shot_times[s].index[ring * pattern.cols..(ring + 1) * pattern.cols];
         for (c, f) in firings.iter().enumerate() {
             let Some(f) = f else { continue };
             let world_from_sensor = if moving {
-                self.track.at(start_time_s + f.time_s).world_from_vehicle() * vehicle_from_sensor
+                match shot_poses {
+                    Some(poses) => poses[s][shot_of[c] as usize],
+                    None => self.track.at(start_time_s + f.time_s).world_from_vehicle() * vehicle_from_sensor,
+                }
             } else {
                 static_world_from_sensor
             };
@@ -348,6 +374,7 @@ impl<'a> Scanner<'a> {
         row: usize,
         view: &mut RowView<'_>,
         scratch: &mut RowScratch,
+        shot_poses: Option<&[Vec<Affine3A>]>,
     ) -> Vec<ExtraEcho> {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
@@ -359,7 +386,7 @@ impl<'a> Scanner<'a> {
         let beams = match &self.static_beams {
             Some(cached) => &cached[row],
             None => {
-                self.fill_row_beams(frame, row, beams);
+                self.fill_row_beams(frame, row, beams, shot_poses);
                 beams
             }
         };
@@ -524,6 +551,28 @@ fn triangle_records(mesh: &SceneMesh) -> (Vec<TriangleRecord>, Vec<Surface>) {
         })
         .collect();
     (records, surfaces)
+}
+
+/// A sensor's distinct shot times (seconds after the frame start) and which one each firing uses.
+struct ShotTimes {
+    /// Distinct shot times, increasing.
+    times: Vec<f64>,
+    /// Per pattern cell (row-major), the index of its shot time in `times` (0 where it does not fire).
+    index: Vec<u32>,
+}
+
+impl ShotTimes {
+    fn new(pattern: &ScanPattern) -> Self {
+        let mut times: Vec<f64> = pattern.firings.iter().flatten().map(|f| f.time_s).collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup_by(|a, b| a.to_bits() == b.to_bits());
+        let index = pattern
+            .firings
+            .iter()
+            .map(|f| f.map_or(0, |f| times.binary_search_by(|t| t.total_cmp(&f.time_s)).unwrap_or_default() as u32))
+            .collect();
+        Self { times, index }
+    }
 }
 
 /// Marks an unfired sensor column in [`RowScratch::beam_of_col`].
