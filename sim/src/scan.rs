@@ -171,7 +171,7 @@ impl<'a> Scanner<'a> {
             let cached = (0..scanner.layout.rows)
                 .map(|row| {
                     let mut beams = RowBeams::default();
-                    scanner.fill_row_beams(0, row, &mut beams, None);
+                    scanner.fill_row_beams(0, row, &mut beams, &[]);
                     beams
                 })
                 .collect();
@@ -248,21 +248,7 @@ impl<'a> Scanner<'a> {
             cloud.reset_cells(rows * cols..cloud.len());
         }
         let start_time_s = index as f64 * self.frame_period_s;
-        // A moving vehicle's pose at each distinct shot time of each sensor, computed once per frame
-        // (many beams share a shot time: all lasers of an OS1 column fire together).
-        let shot_poses: Option<Vec<Vec<Affine3A>>> = (!self.track.is_static()).then(|| {
-            self.shot_times
-                .iter()
-                .zip(&self.vehicle_from_sensor)
-                .map(|(shots, &vehicle_from_sensor)| {
-                    shots
-                        .times
-                        .par_iter()
-                        .map(|&t| self.track.at(start_time_s + t).world_from_vehicle() * vehicle_from_sensor)
-                        .collect()
-                })
-                .collect()
-        });
+        let shot_poses = self.shot_poses(index);
         let extra: Vec<Vec<ExtraEcho>> = if cols == 0 {
             Vec::new()
         } else {
@@ -273,7 +259,7 @@ impl<'a> Scanner<'a> {
                 .into_par_iter()
                 .enumerate()
                 .map_init(RowScratch::default, |scratch, (row, mut view)| {
-                    self.scan_row(index, start_time_s, row, &mut view, scratch, shot_poses.as_deref())
+                    self.scan_row(index, start_time_s, row, &mut view, scratch, &shot_poses)
                 })
                 .collect()
         };
@@ -288,7 +274,8 @@ impl<'a> Scanner<'a> {
     /// followed by two sub-beams at the horizontal edges of its divergence cone.
     pub fn row_rays(&self, frame: usize, row: usize) -> RowRays {
         let mut row_beams = RowBeams::default();
-        self.fill_row_beams(frame, row, &mut row_beams, None);
+        let shot_poses = self.shot_poses(frame);
+        self.fill_row_beams(frame, row, &mut row_beams, &shot_poses);
         let (s, ring) = self.row_source[row];
         let beams = row_beams
             .beam_col
@@ -300,48 +287,69 @@ impl<'a> Scanner<'a> {
                     dir_in_sensor: Vec3::ZERO,
                     time_s: 0.0,
                 });
-                (c as usize, f, row_beams.beam_pose.get(b).copied().unwrap_or(row_beams.static_pose))
+                let pose = row_beams
+                    .beam_shot
+                    .get(b)
+                    .map_or(row_beams.static_pose, |&k| shot_poses[s][k as usize].world_from_sensor);
+                (c as usize, f, pose)
             })
             .collect();
         RowRays { beams, rays: row_beams.rays, sub_rays: row_beams.sub_rays }
     }
 
+    /// A moving vehicle's pose in frame `frame` at each distinct shot time of each sensor (indexed
+    /// like [`ShotTimes::times`]), computed once per frame: many beams share a shot time (all
+    /// lasers of an OS1 column fire together). Empty for a standing vehicle.
+    fn shot_poses(&self, frame: usize) -> Vec<Vec<ShotPose>> {
+        use rayon::prelude::*;
+        if self.track.is_static() {
+            return Vec::new();
+        }
+        let start_time_s = frame as f64 * self.frame_period_s;
+        self.shot_times
+            .iter()
+            .zip(&self.vehicle_from_sensor)
+            .map(|(shots, &vehicle_from_sensor)| {
+                shots
+                    .times
+                    .par_iter()
+                    .map(|&t| {
+                        ShotPose::new(
+                            self.track.at(start_time_s + t).world_from_vehicle() * vehicle_from_sensor,
+                            vehicle_from_sensor,
+                        )
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Fills `out` with the beams and rays of merged row `row` in frame `frame` (see
-    /// [`Scanner::row_rays`]).
-    /// `shot_poses` (per sensor, indexed like [`ShotTimes::times`]) are the frame's
-    /// `world_from_sensor` at each distinct shot time of a moving vehicle; `None` computes each
-    /// beam's pose on the spot.
-    fn fill_row_beams(&self, frame: usize, row: usize, out: &mut RowBeams, shot_poses: Option<&[Vec<Affine3A>]>) {
+    /// [`Scanner::row_rays`]); `shot_poses` is [`Scanner::shot_poses`] of the frame.
+    fn fill_row_beams(&self, frame: usize, row: usize, out: &mut RowBeams, shot_poses: &[Vec<ShotPose>]) {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
         let m = &self.measurements[s];
         let vehicle_from_sensor = self.vehicle_from_sensor[s];
-        let start_time_s = frame as f64 * self.frame_period_s;
         let static_world_from_sensor = self.track.frame_start(frame).world_from_vehicle() * vehicle_from_sensor;
         let moving = !self.track.is_static();
         let t_max = cast_limit_m(m);
         let sub_rays = if m.max_echoes > 1 && m.beam_divergence_rad > 0.0 { 3 } else { 1 };
         let off = (0.5 * m.beam_divergence_rad).tan();
-        let RowBeams { rays, beam_col, beam_pose, beam_of_col, sub_rays: out_sub_rays, static_pose } = out;
+        let RowBeams { rays, beam_col, beam_shot, beam_of_col, sub_rays: out_sub_rays, static_pose } = out;
         *out_sub_rays = sub_rays;
         *static_pose = static_world_from_sensor;
         rays.clear();
         beam_col.clear();
-        beam_pose.clear();
+        beam_shot.clear();
         beam_of_col.clear();
         beam_of_col.resize(pattern.cols, NO_BEAM);
         let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
         let shot_of = &self.shot_times[s].index[ring * pattern.cols..(ring + 1) * pattern.cols];
         for (c, f) in firings.iter().enumerate() {
             let Some(f) = f else { continue };
-            let world_from_sensor = if moving {
-                match shot_poses {
-                    Some(poses) => poses[s][shot_of[c] as usize],
-                    None => self.track.at(start_time_s + f.time_s).world_from_vehicle() * vehicle_from_sensor,
-                }
-            } else {
-                static_world_from_sensor
-            };
+            let world_from_sensor =
+                if moving { shot_poses[s][shot_of[c] as usize].world_from_sensor } else { static_world_from_sensor };
             let origin = world_from_sensor.transform_point3(f.origin_in_sensor);
             let dir = world_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
             rays.push(Ray { origin, dir, t_max });
@@ -354,7 +362,7 @@ impl<'a> Scanner<'a> {
             beam_of_col[c] = beam_col.len() as u32;
             beam_col.push(c as u32);
             if moving {
-                beam_pose.push(world_from_sensor);
+                beam_shot.push(shot_of[c]);
             }
         }
     }
@@ -374,7 +382,7 @@ impl<'a> Scanner<'a> {
         row: usize,
         view: &mut RowView<'_>,
         scratch: &mut RowScratch,
-        shot_poses: Option<&[Vec<Affine3A>]>,
+        shot_poses: &[Vec<ShotPose>],
     ) -> Vec<ExtraEcho> {
         let (s, ring) = self.row_source[row];
         let pattern = &self.patterns[s];
@@ -390,7 +398,7 @@ impl<'a> Scanner<'a> {
                 beams
             }
         };
-        let RowBeams { rays, beam_pose, beam_of_col, sub_rays, static_pose: static_world_from_sensor, beam_col } =
+        let RowBeams { rays, beam_shot, beam_of_col, sub_rays, static_pose: static_world_from_sensor, beam_col } =
             beams;
         let (sub_rays, static_world_from_sensor) = (*sub_rays, *static_world_from_sensor);
         // No clearing: `cast_batch` writes every entry (its contract), so only new entries are filled.
@@ -399,12 +407,7 @@ impl<'a> Scanner<'a> {
 
         let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
         let mut extra = Vec::new();
-        // Rotation taking world vectors to the vehicle frame at a shot: vehicle_from_sensor *
-        // transpose(world_from_sensor). Constant over the row when the vehicle stands still, else
-        // recomputed when the shot's pose changes.
-        let rotation =
-            |world_from_sensor: Affine3A| vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose();
-        let mut vehicle_from_world = (static_world_from_sensor, rotation(static_world_from_sensor));
+        let static_vehicle_from_world = ShotPose::new(static_world_from_sensor, vehicle_from_sensor).vehicle_from_world;
         let row_key = RowKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32 };
         // The row stream's draws for columns 0 ..= the last column with a hit: a prefix of the full
         // row stream, so the same numbers as drawing all columns (rows that hit nothing, e.g. beams
@@ -435,14 +438,8 @@ impl<'a> Scanner<'a> {
             };
             view.time[mc] = start_time_s + f.time_s;
             let centre_dir = rays[b * sub_rays].dir;
-            let any_hit = hits[b * sub_rays..(b + 1) * sub_rays].iter().any(Option::is_some);
-            if any_hit
-                && let Some(&world_from_sensor) = beam_pose.get(b)
-                && vehicle_from_world.0 != world_from_sensor
-            {
-                vehicle_from_world = (world_from_sensor, rotation(world_from_sensor));
-            }
-            let vehicle_from_world = vehicle_from_world.1;
+            let vehicle_from_world =
+                beam_shot.get(b).map_or(static_vehicle_from_world, |&k| shot_poses[s][k as usize].vehicle_from_world);
             // The cell of a hit of this beam reported as echo `echo` by `count` of its sub-rays, or
             // `None` when the sensor reports nothing.
             let hit_cell = |hit: Hit, count: u32, echo: u8| {
@@ -553,6 +550,25 @@ fn triangle_records(mesh: &SceneMesh) -> (Vec<TriangleRecord>, Vec<Surface>) {
     (records, surfaces)
 }
 
+/// The sensor pose at one shot.
+#[derive(Clone, Copy, Debug)]
+struct ShotPose {
+    /// Sensor pose in the world at the shot.
+    world_from_sensor: Affine3A,
+    /// Rotation taking world vectors to the vehicle frame at the shot:
+    /// `vehicle_from_sensor * transpose(world_from_sensor)`.
+    vehicle_from_world: glam::Mat3A,
+}
+
+impl ShotPose {
+    fn new(world_from_sensor: Affine3A, vehicle_from_sensor: Affine3A) -> Self {
+        Self {
+            world_from_sensor,
+            vehicle_from_world: vehicle_from_sensor.matrix3 * world_from_sensor.matrix3.transpose(),
+        }
+    }
+}
+
 /// A sensor's distinct shot times (seconds after the frame start) and which one each firing uses.
 struct ShotTimes {
     /// Distinct shot times, increasing.
@@ -587,8 +603,8 @@ struct RowBeams {
     sub_rays: usize,
     /// Sensor column of each fired beam.
     beam_col: Vec<u32>,
-    /// `world_from_sensor` of each fired beam at its shot time (moving vehicle only, else empty).
-    beam_pose: Vec<Affine3A>,
+    /// Shot-time index ([`ShotTimes::times`]) of each fired beam (moving vehicle only, else empty).
+    beam_shot: Vec<u32>,
     /// `world_from_sensor` at the start of the frame: the pose of every beam of a standing vehicle.
     static_pose: Affine3A,
     /// Beam index of each sensor column, [`NO_BEAM`] where the sensor does not fire.
