@@ -63,7 +63,7 @@
 
 use glam::Vec3;
 
-use crate::error::{ClassifyError, Result};
+use crate::error::{ClassifyError, Result, is_valid};
 use crate::neighbours::GridView;
 
 /// Parameters of clustering and of the cluster rules.
@@ -210,7 +210,7 @@ pub fn linked(pa: Vec3, pb: Vec3, na: Vec3, nb: Vec3, params: &ClusterParams) ->
 }
 
 /// Clusters the candidate cells (`candidate[i]`, unit normals `normal[i]`) of `view` by conditional
-/// Euclidean clustering on the grid; candidates without a return are left out (never ground). Afterwards [`ClusterWorkspace::cluster_of`] gives each candidate's cluster root and
+/// Euclidean clustering on the grid. Afterwards [`ClusterWorkspace::cluster_of`] gives each candidate's cluster root and
 /// [`ClusterWorkspace::cluster_size`] its size.
 ///
 /// Every cluster's root is its smallest cell index (unions keep the smaller root), so the result
@@ -230,6 +230,8 @@ pub fn cluster_candidates(
     let n = rows * cols;
     let points = &view.points[..n];
     let normal = &normal[..n];
+    ws.parent.clear();
+    ws.parent.extend((0..n as u32).map(|i| if candidate[i as usize] { i } else { NONE }));
     // Sizes are non-zero only at the last clustering's roots: reset those (no pass over all cells).
     if ws.size.len() == n {
         for &root in &ws.roots {
@@ -240,14 +242,11 @@ pub fn cluster_candidates(
         ws.size.resize(n, 0);
     }
     ws.valid.resize(n, false);
-    ws.parent.resize(n, NONE);
     let mut returns = 0;
-    for (i, ((v, p), parent)) in ws.valid.iter_mut().zip(points).zip(&mut ws.parent).enumerate() {
+    for (v, p) in ws.valid.iter_mut().zip(points) {
         // `is_valid` without short-circuit branches, so that it vectorizes.
         *v = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
         returns += usize::from(*v);
-        // Only candidates with a return are clustered (each cell its own cluster to begin with).
-        *parent = if *v & candidate[i] { i as u32 } else { NONE };
     }
     ws.returns = returns;
     // Per column of the current row: returns in the rows below, at and above.
@@ -483,8 +482,7 @@ impl ClusterWorkspace {
         }
         for i in 0..n {
             let root = self.parent[i];
-            // Clustered cells all hold returns ([`cluster_candidates`]).
-            ground[i] = root != NONE && self.root_ground[root as usize];
+            ground[i] = root != NONE && self.root_ground[root as usize] && is_valid(points[i]);
         }
     }
 }
