@@ -8,6 +8,16 @@
 //!
 //! Work is split by rows of the merged grid (one rayon task per row); every random draw is keyed by
 //! (seed, frame, sensor, ring, column), so output is identical at any thread count.
+//!
+//! Cost (the frame should cost little more than casting its rays):
+//! - every plane-0 cell is written exactly once per frame (walking the merged columns with the
+//!   merged -> sensor column table of [`RigLayout::sensor_col_of`]), so reused clouds need no reset;
+//! - a standing vehicle's rays are the same in every frame and are built once, in [`Scanner::new`];
+//!   a moving vehicle's pose is computed once per distinct shot time per frame, not per beam;
+//! - rays and hits live in per-worker scratch buffers reused from row to row (they carry nothing
+//!   from one row to the next, so results do not depend on the split);
+//! - a row draws its noise stream only up to its last column with a hit (a prefix: same numbers);
+//! - each triangle's normal and surface index sit in one 16-byte record (one cache miss per hit).
 
 use glam::{Affine3A, Vec3};
 
