@@ -359,8 +359,10 @@ fn fill_one(
 #[inline(always)]
 fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
     let (dx, dy, dz, ok, len) = (&d.dx, &d.dy, &d.dz, &d.ok, &d.len);
-    let (mut nx, mut ny, mut nz, mut inv) = ([[0f32; L]; 8], [[0f32; L]; 8], [[0f32; L]; 8], [[0f32; L]; 8]);
     let (mut sx, mut sy, mut sz, mut pairs) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+    // Sum of the unit pair normals `n_i / |n_i|`: Eq. 3's sum of `n . n_i / |n_i|` is `n` dotted
+    // with it (one dot product per cell instead of one per pair).
+    let (mut ex, mut ey, mut ez) = ([0f32; L], [0f32; L], [0f32; L]);
     for k in 0..8 {
         // The previous neighbour of d1 is d8 (Eq. 1's d_(i-1)).
         let p = (k + 7) % 8;
@@ -376,7 +378,9 @@ fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f
             let valid = if nl2 > 1e-24 * t * t { ok[k][l] * ok[p][l] } else { 0.0 };
             let iv = valid * rsqrt(nl2.max(f32::MIN_POSITIVE));
             let w = valid / (lk + lp).max(f32::MIN_POSITIVE);
-            (nx[k][l], ny[k][l], nz[k][l], inv[k][l]) = (x, y, z, iv);
+            ex[l] += x * iv;
+            ey[l] += y * iv;
+            ez[l] += z * iv;
             sx[l] += x * w;
             sy[l] += y * w;
             sz[l] += z * w;
@@ -392,15 +396,9 @@ fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f
         (ux[l], uy[l], uz[l]) = (sx[l] * inv_len, sy[l] * inv_len, sz[l] * inv_len);
     }
     // Eq. 3: mean cosine similarity between n and its generating normals.
-    let mut cos_sum = [0f32; L];
-    for k in 0..8 {
-        for l in 0..L {
-            cos_sum[l] += (ux[l] * nx[k][l] + uy[l] * ny[k][l] + uz[l] * nz[k][l]) * inv[k][l];
-        }
-    }
     let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
     for l in 0..L {
-        let q = cos_sum[l] / pairs[l];
+        let q = (ux[l] * ex[l] + uy[l] * ey[l] + uz[l] * ez[l]) / pairs[l];
         (ox[l], oy[l], oz[l], rho[l]) = if good[l] { (ux[l], uy[l], uz[l], q) } else { (0.0, 0.0, 0.0, 0.0) };
     }
     (ox, oy, oz, rho)
