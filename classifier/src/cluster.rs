@@ -494,7 +494,6 @@ mod tests {
     //! the search finds where a direct one is missing), on damaged synthetic frames.
 
     use super::*;
-    use crate::synthetic::{SyntheticSensor, car, flat_ground};
     use crate::{Nitsch, NitschParams};
     use rand::{RngExt, SeedableRng};
 
@@ -549,25 +548,8 @@ mod tests {
         (0..n).map(|i| ws.cluster_of(i)).collect()
     }
 
-    /// A small frame with cars, a fraction `drop` of returns removed and z noise.
     fn frame(drop: f32, seed: u64, spinning: bool) -> sim::OrderedCloud {
-        let shapes = [flat_ground(), car(6.0, 1.0, 0.0), car(-9.0, -2.0, 0.0)];
-        let sensor = if spinning {
-            SyntheticSensor::spinning(24, 360, -25.0, 5.0, 1.8)
-        } else {
-            SyntheticSensor::forward(24, 200, -25.0, 5.0, 90.0, 1.8)
-        };
-        let mut cloud = sensor.scan(&shapes);
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
-        for i in 0..cloud.point_in_vehicle.len() {
-            if rng.random::<f32>() < drop {
-                cloud.point_in_vehicle[i] = Vec3::NAN;
-                cloud.range_m[i] = f32::NAN;
-            } else {
-                cloud.point_in_vehicle[i].z += rng.random::<f32>() * 0.1 - 0.05;
-            }
-        }
-        cloud
+        crate::synthetic::noisy_cars_frame(drop, seed, spinning, 0.05)
     }
 
     #[test]

@@ -427,8 +427,6 @@ mod tests {
     use super::*;
     use crate::error::is_valid;
     use crate::neighbours::detect_wrap;
-    use crate::synthetic::{SyntheticSensor, car, flat_ground};
-    use rand::{RngExt, SeedableRng};
 
     /// The per-cell definition: neighbours by [`GridView::neighbours`], then Eq. 1-3.
     fn reference(view: &GridView<'_>, params: &FeatureParams) -> Vec<(Vec3, f32, f32)> {
@@ -529,25 +527,8 @@ mod tests {
         (n, cos_sum / pairs)
     }
 
-    /// A small spinning frame with cars, a fraction `drop` of returns removed and z noise.
     fn frame(drop: f32, seed: u64, spinning: bool) -> sim::OrderedCloud {
-        let shapes = [flat_ground(), car(6.0, 1.0, 0.0), car(-9.0, -2.0, 0.0)];
-        let sensor = if spinning {
-            SyntheticSensor::spinning(24, 360, -25.0, 5.0, 1.8)
-        } else {
-            SyntheticSensor::forward(24, 200, -25.0, 5.0, 90.0, 1.8)
-        };
-        let mut cloud = sensor.scan(&shapes);
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
-        for i in 0..cloud.point_in_vehicle.len() {
-            if rng.random::<f32>() < drop {
-                cloud.point_in_vehicle[i] = Vec3::NAN;
-                cloud.range_m[i] = f32::NAN;
-            } else {
-                cloud.point_in_vehicle[i].z += rng.random::<f32>() * 0.06 - 0.03;
-            }
-        }
-        cloud
+        crate::synthetic::noisy_cars_frame(drop, seed, spinning, 0.03)
     }
 
     #[test]

@@ -195,3 +195,27 @@ pub fn benchmark_frame() -> OrderedCloud {
     ];
     sensor.scan(&shapes)
 }
+
+/// A small frame with two cars on flat ground (24 rows; spinning 360 columns or a 90 deg forward
+/// sensor of 200), a fraction `drop` of returns removed and uniform z noise of +-`z_noise_m`, from
+/// Xoshiro256++ seeded with `seed`: the test frame of the equivalence tests of the fast paths.
+pub fn noisy_cars_frame(drop: f32, seed: u64, spinning: bool, z_noise_m: f32) -> OrderedCloud {
+    use rand::{RngExt, SeedableRng};
+    let shapes = [flat_ground(), car(6.0, 1.0, 0.0), car(-9.0, -2.0, 0.0)];
+    let sensor = if spinning {
+        SyntheticSensor::spinning(24, 360, -25.0, 5.0, 1.8)
+    } else {
+        SyntheticSensor::forward(24, 200, -25.0, 5.0, 90.0, 1.8)
+    };
+    let mut cloud = sensor.scan(&shapes);
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    for i in 0..cloud.point_in_vehicle.len() {
+        if rng.random::<f32>() < drop {
+            cloud.point_in_vehicle[i] = Vec3::NAN;
+            cloud.range_m[i] = f32::NAN;
+        } else {
+            cloud.point_in_vehicle[i].z += (rng.random::<f32>() * 2.0 - 1.0) * z_noise_m;
+        }
+    }
+    cloud
+}
