@@ -179,27 +179,9 @@ impl Wide4 {
                 }
             }
             // Descend into the nearest inner child; push the others farthest first.
-            let mut next = None;
-            for &(c, t) in inner[..q].iter().rev() {
-                if t <= best_t {
-                    if let Some(prev) = next {
-                        stack.push(prev);
-                    }
-                    next = Some((c, t));
-                }
-            }
-            match next {
-                Some((c, _)) => node = c,
-                None => loop {
-                    match stack.pop() {
-                        Some((c, t)) if t <= best_t => {
-                            node = c;
-                            break;
-                        }
-                        Some(_) => continue,
-                        None => return best,
-                    }
-                },
+            match next_node(&inner[..q], stack, best_t) {
+                Some(c) => node = c,
+                None => return best,
             }
         }
     }
@@ -347,27 +329,9 @@ impl Wide4 {
                     far_t = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
                 }
             }
-            let mut next = None;
-            for &(c, t) in inner[..q].iter().rev() {
-                if t <= far_t {
-                    if let Some(prev) = next {
-                        stack.push(prev);
-                    }
-                    next = Some((c, t));
-                }
-            }
-            match next {
-                Some((c, _)) => node = c,
-                None => loop {
-                    match stack.pop() {
-                        Some((c, t)) if t <= far_t => {
-                            node = c;
-                            break;
-                        }
-                        Some(_) => continue,
-                        None => return true,
-                    }
-                },
+            match next_node(&inner[..q], stack, far_t) {
+                Some(c) => node = c,
+                None => return true,
             }
         }
     }
@@ -421,4 +385,29 @@ fn slab4_fan<const ONE_ORIGIN: bool>(
         hit[k] = t_near[k] <= t_far[k] && n.count[k] != EMPTY;
     }
     (t_near, hit)
+}
+
+/// The next node to visit: the nearest of `inner` (children met, nearest first) whose entry distance
+/// is within `limit`, pushing the other such children farthest first; else the next node popped off
+/// `stack` within `limit`; `None` when traversal is done.
+#[inline(always)]
+fn next_node(inner: &[(u32, f32)], stack: &mut Vec<(u32, f32)>, limit: f32) -> Option<u32> {
+    let mut next = None;
+    for &(c, t) in inner.iter().rev() {
+        if t <= limit {
+            if let Some(prev) = next {
+                stack.push(prev);
+            }
+            next = Some((c, t));
+        }
+    }
+    if let Some((c, _)) = next {
+        return Some(c);
+    }
+    while let Some((c, t)) = stack.pop() {
+        if t <= limit {
+            return Some(c);
+        }
+    }
+    None
 }
