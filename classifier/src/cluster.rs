@@ -63,7 +63,7 @@
 
 use glam::Vec3;
 
-use crate::error::{ClassifyError, Result, is_valid};
+use crate::error::{ClassifyError, Result};
 use crate::neighbours::GridView;
 
 /// Parameters of clustering and of the cluster rules.
@@ -161,6 +161,8 @@ pub struct ClusterWorkspace {
     outside_sum: Vec<Vec3>,
     /// x-y bounding box per root.
     bbox: Vec<(glam::Vec2, glam::Vec2)>,
+    /// Candidate cells (cells with a cluster) in increasing order.
+    members: Vec<u32>,
     /// Ground-area squares: (sum z, count) per square in a bounding box.
     area: Vec<(f32, u32)>,
     /// Decision per root.
@@ -226,12 +228,23 @@ pub fn cluster_candidates(
     params: &ClusterParams,
     ws: &mut ClusterWorkspace,
 ) {
+    cluster_candidates_with(view, None, candidate, normal, params, ws);
+}
+
+/// [`cluster_candidates`] with the cells that hold a return given (`valid`, as
+/// [`crate::features::Features::valid`] has them) rather than found again from the points.
+pub fn cluster_candidates_with(
+    view: &GridView<'_>,
+    valid: Option<&[bool]>,
+    candidate: &[bool],
+    normal: &[Vec3],
+    params: &ClusterParams,
+    ws: &mut ClusterWorkspace,
+) {
     let (rows, cols) = (view.rows, view.cols);
     let n = rows * cols;
     let points = &view.points[..n];
     let normal = &normal[..n];
-    ws.parent.clear();
-    ws.parent.extend((0..n as u32).map(|i| if candidate[i as usize] { i } else { NONE }));
     // Sizes are non-zero only at the last clustering's roots: reset those (no pass over all cells).
     if ws.size.len() == n {
         for &root in &ws.roots {
@@ -242,17 +255,34 @@ pub fn cluster_candidates(
         ws.size.resize(n, 0);
     }
     ws.valid.resize(n, false);
-    let mut returns = 0;
-    for (v, p) in ws.valid.iter_mut().zip(points) {
-        // `is_valid` without short-circuit branches, so that it vectorizes.
-        *v = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
-        returns += usize::from(*v);
+    match valid {
+        Some(valid) => ws.valid.copy_from_slice(&valid[..n]),
+        None => {
+            for (v, p) in ws.valid.iter_mut().zip(points) {
+                // `is_valid` without short-circuit branches, so that it vectorizes.
+                *v = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+            }
+        }
     }
-    ws.returns = returns;
+    ws.returns = ws.valid.iter().map(|&v| usize::from(v)).sum();
+    // Only cells with a return can be candidates. The member list (candidates in increasing
+    // order) is appended without a branch per cell: the passes below visit only the members.
+    ws.parent.resize(n, NONE);
+    ws.members.resize(n, 0);
+    let mut members = 0;
+    for (i, ((p, &c), &v)) in ws.parent.iter_mut().zip(&candidate[..n]).zip(&ws.valid[..n]).enumerate() {
+        let member = c & v;
+        *p = if member { i as u32 } else { NONE };
+        ws.members[members] = i as u32;
+        members += usize::from(member);
+    }
+    ws.members.truncate(members);
     // Per column of the current row: returns in the rows below, at and above.
     ws.column_valid.clear();
     ws.column_valid.resize(cols, false);
     let parent = &mut ws.parent;
+    // Index of the next member to visit.
+    let mut next = 0;
     for r in 0..rows {
         let row = r * cols..(r + 1) * cols;
         let interior_row = r > 0 && r + 1 < rows;
@@ -262,14 +292,14 @@ pub fn cluster_candidates(
                 *v = below[c] & at[c] & above[c];
             }
         }
-        // Root of the previous cell's cluster when that cell is a candidate (NONE otherwise).
-        let mut prev_root = NONE;
-        for c in 0..cols {
-            let i = row.start + c;
-            if parent[i] == NONE {
-                prev_root = NONE;
-                continue;
-            }
+        // The previous member and its cluster's root.
+        let (mut prev, mut prev_root) = (usize::MAX, NONE);
+        while next < ws.members.len() && (ws.members[next] as usize) < row.end {
+            let i = ws.members[next] as usize;
+            next += 1;
+            let c = i - row.start;
+            // The left neighbour's root when it is a member (NONE otherwise).
+            let left_root = if prev.wrapping_add(1) == i { prev_root } else { NONE };
             let (p, np) = (points[i], normal[i]);
             let dense = interior_row
                 && c > 0
@@ -288,8 +318,8 @@ pub fn cluster_candidates(
                 }
             };
             if dense {
-                if prev_root != NONE {
-                    join(parent, i - 1, prev_root, &mut ri);
+                if left_root != NONE {
+                    join(parent, i - 1, left_root, &mut ri);
                 }
                 for j in [i - cols - 1, i - cols, i - cols + 1] {
                     // A parent equal to this cell's root (a root) means the same cluster already:
@@ -310,23 +340,42 @@ pub fn cluster_candidates(
                     }
                 }
             }
-            prev_root = ri;
+            (prev, prev_root) = (i, ri);
         }
     }
+    // Path compression, cluster sizes, the member list and each cluster's x-y bounding box in one
+    // pass. A root is its cluster's smallest cell, so it is the first member met: its box starts there.
     ws.roots.clear();
-    for i in 0..n {
+    ws.bbox.resize(n, (glam::Vec2::ZERO, glam::Vec2::ZERO));
+    // Consecutive members mostly share a root: its size and box stay in registers for the run
+    // (no read-modify-write chain through memory per cell), and are stored when the root changes.
+    let (mut run, mut count, mut lo, mut hi) = (NONE, 0u32, glam::Vec2::ZERO, glam::Vec2::ZERO);
+    for &i in &ws.members {
+        let i = i as usize;
         let p = parent[i];
-        if p != NONE {
-            // Parents come before their children, so going up the cells the parent's own parent
-            // is usually the root already.
-            let pp = parent[p as usize];
-            let root = if parent[pp as usize] == pp { pp } else { find(parent, i as u32) };
-            parent[i] = root;
-            ws.size[root as usize] += 1;
+        // Parents come before their children, so going up the cells the parent's own parent
+        // is usually the root already.
+        let pp = parent[p as usize];
+        let root = if parent[pp as usize] == pp { pp } else { find(parent, i as u32) };
+        parent[i] = root;
+        let xy = points[i].truncate();
+        if root != run {
+            if run != NONE {
+                (ws.size[run as usize], ws.bbox[run as usize]) = (count, (lo, hi));
+            }
+            run = root;
             if root == i as u32 {
                 ws.roots.push(root);
+                (count, lo, hi) = (0, xy, xy);
+            } else {
+                (count, (lo, hi)) = (ws.size[root as usize], ws.bbox[root as usize]);
             }
         }
+        count += 1;
+        (lo, hi) = (lo.min(xy), hi.max(xy));
+    }
+    if run != NONE {
+        (ws.size[run as usize], ws.bbox[run as usize]) = (count, (lo, hi));
     }
 }
 
@@ -367,7 +416,9 @@ impl ClusterWorkspace {
     }
 
     /// Applies the cluster rules (module docs) and writes the ground decision of every cell of the
-    /// plane into `ground` (non-candidates false). `returns` is the number of returns of the plane.
+    /// plane into `ground` (non-candidates false). `points` are the points of the last
+    /// [`cluster_candidates`] (whose pass also found each cluster's bounding box) and `returns` the
+    /// number of returns of the plane.
     pub fn decide(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
         let n = self.parent.len();
         // Every candidate's parent is its root already ([`cluster_candidates`] compresses the paths).
@@ -379,50 +430,58 @@ impl ClusterWorkspace {
         };
         // Ground area: squares holding points of the largest cluster, over its bounding box.
         let cell = params.area_cell_m;
-        let (mut lo, mut hi) = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
-        for i in 0..n {
-            if self.parent[i] == largest as u32 {
-                lo = lo.min(points[i].truncate());
-                hi = hi.max(points[i].truncate());
-            }
-        }
+        let (lo, hi) = self.bbox[largest];
         let nx = (((hi.x - lo.x) / cell).floor() as usize).saturating_add(1).min(4096);
         let ny = (((hi.y - lo.y) / cell).floor() as usize).saturating_add(1).min(4096);
         self.area.clear();
         self.area.resize(nx * ny, (0.0, 0));
-        let square =
-            |p: Vec3| -> (isize, isize) { (floor_isize((p.x - lo.x) / cell), floor_isize((p.y - lo.y) / cell)) };
-        for i in 0..n {
-            if self.parent[i] == largest as u32 {
-                let (x, y) = square(points[i]);
-                let (x, y) = (x.clamp(0, nx as isize - 1) as usize, y.clamp(0, ny as isize - 1) as usize);
-                let e = &mut self.area[y * nx + x];
-                e.0 += points[i].z;
-                e.1 += 1;
+        // A multiplication rather than a division per coordinate (exactly the quotient for the
+        // default 2 m squares, and for any power of two).
+        let per_cell = 1.0 / cell;
+        let square = |p: Vec3| -> (isize, isize) {
+            (floor_isize((p.x - lo.x) * per_cell), floor_isize((p.y - lo.y) * per_cell))
+        };
+        // Consecutive points mostly fall in one square: its sums stay in registers for the run
+        // (the same additions in the same order, without a chain through memory per point).
+        let (mut run, mut acc) = (usize::MAX, (0f32, 0u32));
+        for &i in &self.members {
+            if self.parent[i as usize] == largest as u32 {
+                let p = points[i as usize];
+                // The largest cluster's points lie inside its box: `p - lo >= 0`, whose truncation
+                // is its floor (one conversion, no correction).
+                let x = (((p.x - lo.x) * per_cell) as usize).min(nx - 1);
+                let y = (((p.y - lo.y) * per_cell) as usize).min(ny - 1);
+                let k = y * nx + x;
+                if k != run {
+                    if run != usize::MAX {
+                        self.area[run] = acc;
+                    }
+                    (run, acc) = (k, self.area[k]);
+                }
+                acc = (acc.0 + p.z, acc.1 + 1);
             }
+        }
+        if run != usize::MAX {
+            self.area[run] = acc;
         }
         // Area test per cluster: count inside points and their height above the local ground.
         // Per-root arrays: sized once, reset at the roots only (they are read nowhere else).
-        let empty_box = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
         self.inside.resize(n, 0);
         self.height_sum.resize(n, 0.0);
         self.outside_sum.resize(n, Vec3::ZERO);
-        self.bbox.resize(n, empty_box);
         self.root_ground.resize(n, false);
         for &root in &self.roots {
             let r = root as usize;
-            (self.inside[r], self.height_sum[r], self.outside_sum[r], self.bbox[r]) = (0, 0.0, Vec3::ZERO, empty_box);
+            (self.inside[r], self.height_sum[r], self.outside_sum[r]) = (0, 0.0, Vec3::ZERO);
             self.root_ground[r] = false;
         }
-        for i in 0..n {
-            let root = self.parent[i];
-            if root == NONE || root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points
-            {
+        for &i in &self.members {
+            let root = self.parent[i as usize];
+            if root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points {
                 continue;
             }
-            let b = &mut self.bbox[root as usize];
-            (b.0, b.1) = (b.0.min(points[i].truncate()), b.1.max(points[i].truncate()));
-            let (x, y) = square(points[i]);
+            let p = points[i as usize];
+            let (x, y) = square(p);
             let (mut zs, mut cnt) = (0.0f32, 0u32);
             for dy in -1..=1 {
                 for dx in -1..=1 {
@@ -436,9 +495,9 @@ impl ClusterWorkspace {
             }
             if cnt > 0 {
                 self.inside[root as usize] += 1;
-                self.height_sum[root as usize] += points[i].z - zs / cnt as f32;
+                self.height_sum[root as usize] += p.z - zs / cnt as f32;
             } else {
-                self.outside_sum[root as usize] += points[i];
+                self.outside_sum[root as usize] += p;
             }
         }
         let (zsum, zcount) = self.area.iter().fold((0f64, 0u64), |(a, b), e| (a + f64::from(e.0), b + u64::from(e.1)));
@@ -480,9 +539,10 @@ impl ClusterWorkspace {
                 best.is_some_and(|(_, z)| c.z - z <= params.max_step_m)
             };
         }
-        for i in 0..n {
-            let root = self.parent[i];
-            ground[i] = root != NONE && self.root_ground[root as usize] && is_valid(points[i]);
+        // Members are the cells with a return and a cluster; every other cell is not ground.
+        ground[..n].fill(false);
+        for &i in &self.members {
+            ground[i as usize] = self.root_ground[self.parent[i as usize] as usize];
         }
     }
 }

@@ -36,6 +36,8 @@
 // Lane arrays are indexed by neighbour and lane on purpose (vectorized across cells).
 #![allow(clippy::needless_range_loop)]
 
+mod squares;
+
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
@@ -115,9 +117,18 @@ struct Soa {
     valid: Vec<bool>,
     /// Per column of the row being processed: returns in the rows below, at and above.
     column_valid: Vec<bool>,
+    /// The two square rows around the row being processed ([`squares::square_row`]), by parity.
+    squares: [Vec<squares::SquareChunk>; 2],
+    /// Horizontal edge lengths of the row being processed.
+    horizontal: Vec<f32>,
 }
 
 impl Features {
+    /// Whether each cell of the last computed plane holds a return (all three coordinates finite).
+    pub fn valid(&self) -> &[bool] {
+        &self.soa.valid[..self.g_rho.len()]
+    }
+
     /// Resizes the buffers to `n` cells (no reallocation when the size is unchanged).
     fn resize(&mut self, n: usize) {
         self.normal.resize(n, Vec3::ZERO);
@@ -148,6 +159,7 @@ struct Lanes {
 #[derive(Clone, Copy)]
 struct Tests {
     max_d2: f32,
+    max_d: f32,
     keep: [f32; 8],
 }
 
@@ -161,15 +173,47 @@ impl Tests {
         // `&` rather than `&&`: no branch per lane, so the lanes vectorize.
         (l2 <= self.max_d2) & (l2 > 0.0) & !(range_j < self.keep[k] * range)
     }
+
+    /// [`Tests::keep`] from the neighbour's distance `len` rather than its square.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    #[inline(always)]
+    fn keep_len(&self, k: usize, len: f32, range_j: f32, range: f32) -> bool {
+        (len <= self.max_d) & (len > 0.0) & !(range_j < self.keep[k] * range)
+    }
+}
+
+/// Per-lane sums over a cell's pairs: Eq. 2's weighted normal sum, the sum of the unit pair normals
+/// (Eq. 3) and the number of pairs.
+#[derive(Default)]
+struct Acc {
+    s: [[f32; L]; 3],
+    e: [[f32; L]; 3],
+    pairs: [f32; L],
+}
+
+impl Acc {
+    /// Adds pair normal `n` with `1 / |n|` factor `iv` and Eq. 2 weight `w` (both 0 for a
+    /// missing pair) to lane `l`; `valid` is 1 for a pair that exists.
+    #[inline(always)]
+    fn add(&mut self, l: usize, n: [f32; 3], iv: f32, w: f32, valid: f32) {
+        for a in 0..3 {
+            self.e[a][l] += n[a] * iv;
+            self.s[a][l] += n[a] * w;
+        }
+        self.pairs[l] += valid;
+    }
 }
 
 /// Computes the features of every cell of `view` into `out`.
 ///
-/// Cells whose 8 direct neighbours all hold returns (the common case) take their offsets straight
-/// from the neighbouring rows, `L` cells at a time; the others use [`GridView::neighbours`]. Either
-/// way every cell gets the result of the per-cell definition within 1e-5 (tested against it: the
-/// reciprocal square roots of [`rsqrt`] replace square roots and divisions). All code paths give
-/// the same bits (plain IEEE operations, no fused multiply-add).
+/// Cells whose 8 direct neighbours all hold returns (the common case) take their pair normals and
+/// neighbour distances from the grid squares around them, `L` cells at a time: each square's 4
+/// triangles and 3 edges are computed once and shared by the two cells that use each ([`squares`]).
+/// The others use [`GridView::neighbours`] and their own cross products. Either way every cell gets
+/// the result of the per-cell definition within 1e-5 (tested against it: the reciprocal square
+/// roots of [`rsqrt`] replace square roots and divisions, and a shared triangle's cross product is
+/// rounded as computed from one of its corners). Every instruction-set variant gives the same bits
+/// (plain IEEE operations, no fused multiply-add).
 pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx512f") {
@@ -212,9 +256,10 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     let n = rows * cols;
     out.resize(n);
     let soa = &mut out.soa;
-    soa.x.resize(n, 0.0);
-    soa.y.resize(n, 0.0);
-    soa.z.resize(n, 0.0);
+    // Padded past the last row: the square rows read `L + 1` values beyond their last column.
+    for a in [&mut soa.x, &mut soa.y, &mut soa.z] {
+        a.resize(n + L + 1, f32::NAN);
+    }
     soa.valid.resize(n, false);
     soa.column_valid.resize(cols, false);
     let (xs, ys, zs, valid) = (&mut soa.x[..n], &mut soa.y[..n], &mut soa.z[..n], &mut soa.valid[..n]);
@@ -228,8 +273,17 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     let lat = factor(params.lateral_occlusion_ratio);
     let tests = Tests {
         max_d2: params.max_neighbour_distance_m * params.max_neighbour_distance_m,
+        max_d: params.max_neighbour_distance_m,
         keep: [up, up, lat, other, other, other, lat, up],
     };
+    // The fast path needs a square row on either side of the row and blocks clear of both edges.
+    let fast = rows >= 3 && cols >= L + 2;
+    if fast {
+        for sq in &mut soa.squares {
+            sq.resize(squares::chunks(cols), [[0.0; L + 1]; squares::SQUARE_FIELDS]);
+        }
+        soa.horizontal.resize(cols, 0.0);
+    }
     let min_pairs = params.min_valid_pairs as f32;
     let ranges = &view.ranges[..n];
     let mut lanes =
@@ -242,6 +296,15 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
             for (c, v) in soa.column_valid.iter_mut().enumerate() {
                 *v = below[c] & at[c] & above[c];
             }
+        }
+        if interior_row && fast {
+            // Square rows r - 1 and r (the first computed at row 1, each later one once).
+            let (xs, ys, zs) = (&soa.x[..], &soa.y[..], &soa.z[..]);
+            if r == 1 {
+                squares::square_row(xs, ys, zs, 0, cols, &mut soa.squares[0]);
+            }
+            squares::square_row(xs, ys, zs, r, cols, &mut soa.squares[r % 2]);
+            squares::horizontal_row(xs, ys, zs, r, cols, &mut soa.horizontal);
         }
         let mut c0 = 0;
         while c0 < cols {
@@ -262,24 +325,34 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
                 continue;
             }
             let mut cell_ok = [true; L];
-            if dense {
-                fill_dense(soa, ranges, i0, cols, &tests, &mut lanes);
-            } else if interior_row && m == L && c0 > 0 && c0 + L < cols {
-                // Some cells lack a direct neighbour: all lanes the fast way, then those cells again
-                // by the general search.
-                fill_dense(soa, ranges, i0, cols, &tests, &mut lanes);
-                let cv = &soa.column_valid[c0 - 1..c0 + L + 1];
-                for l in 0..L {
-                    if !(cv[l] & cv[l + 1] & cv[l + 2]) {
-                        cell_ok[l] = fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
+            let (nx, ny, nz, rho) = if interior_row && fast && m == L && c0 > 0 && c0 + L < cols {
+                let (below, above) = (&soa.squares[(r - 1) % 2], &soa.squares[r % 2]);
+                let acc = squares::dense_block(ranges, below, above, &soa.horizontal, r, c0 / L, cols, &tests);
+                let mut f = acc.finish(min_pairs);
+                if !dense {
+                    // Some cells lack a direct neighbour: those again by the general search.
+                    let cv = &soa.column_valid[c0 - 1..c0 + L + 1];
+                    let mut general = [false; L];
+                    for l in 0..L {
+                        if !(cv[l] & cv[l + 1] & cv[l + 2]) {
+                            general[l] = true;
+                            cell_ok[l] = fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
+                        }
+                    }
+                    let g = lane_features(&lanes, min_pairs);
+                    for l in 0..L {
+                        if general[l] {
+                            (f.0[l], f.1[l], f.2[l], f.3[l]) = (g.0[l], g.1[l], g.2[l], g.3[l]);
+                        }
                     }
                 }
+                f
             } else {
                 for l in 0..L {
                     cell_ok[l] = l < m && fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
                 }
-            }
-            let (nx, ny, nz, rho) = lane_features(&lanes, min_pairs);
+                lane_features(&lanes, min_pairs)
+            };
             // Cells without features get zeros (selects, not branches: the lanes vectorize).
             let (mut ox, mut oy, mut oz, mut orho, mut og) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L], [0f32; L]);
             for l in 0..L {
@@ -294,26 +367,6 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
             out.n_rho[i0..i0 + m].copy_from_slice(&orho[..m]);
             out.g_rho[i0..i0 + m].copy_from_slice(&og[..m]);
             c0 += m;
-        }
-    }
-}
-
-/// Offsets of the `L` cells from `i0` on, all with their 8 direct neighbours present.
-#[inline(always)]
-fn fill_dense(soa: &Soa, ranges: &[f32], i0: usize, cols: usize, tests: &Tests, lanes: &mut Lanes) {
-    let at = |a: &[f32], i: usize| -> [f32; L] { a[i..i + L].try_into().expect("L cells") };
-    let (px, py, pz, pr) = (at(&soa.x, i0), at(&soa.y, i0), at(&soa.z, i0), at(ranges, i0));
-    for (k, &(dr, dc)) in OFFSETS.iter().enumerate() {
-        let j0 = (i0 as isize + dr * cols as isize + dc) as usize;
-        let (qx, qy, qz, qr) = (at(&soa.x, j0), at(&soa.y, j0), at(&soa.z, j0), at(ranges, j0));
-        for l in 0..L {
-            let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
-            // glam's length_squared: (x * x + y * y) + z * z.
-            let l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            // A dropped neighbour keeps its (finite) offset: `ok` 0 gives its pairs weight 0.
-            lanes.ok[k][l] = if tests.keep(k, l2, qr[l], pr[l]) { 1.0 } else { 0.0 };
-            (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
-            lanes.len[k][l] = l2.sqrt();
         }
     }
 }
@@ -359,10 +412,7 @@ fn fill_one(
 #[inline(always)]
 fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
     let (dx, dy, dz, ok, len) = (&d.dx, &d.dy, &d.dz, &d.ok, &d.len);
-    let (mut sx, mut sy, mut sz, mut pairs) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
-    // Sum of the unit pair normals `n_i / |n_i|`: Eq. 3's sum of `n . n_i / |n_i|` is `n` dotted
-    // with it (one dot product per cell instead of one per pair).
-    let (mut ex, mut ey, mut ez) = ([0f32; L], [0f32; L], [0f32; L]);
+    let mut acc = Acc::default();
     for k in 0..8 {
         // The previous neighbour of d1 is d8 (Eq. 1's d_(i-1)).
         let p = (k + 7) % 8;
@@ -377,31 +427,34 @@ fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f
             // 1 where the pair exists, else 0 (a select, not a conversion).
             let valid = if nl2 > 1e-24 * t * t { ok[k][l] * ok[p][l] } else { 0.0 };
             let iv = valid * rsqrt(nl2.max(f32::MIN_POSITIVE));
-            let w = valid / (lk + lp).max(f32::MIN_POSITIVE);
-            ex[l] += x * iv;
-            ey[l] += y * iv;
-            ez[l] += z * iv;
-            sx[l] += x * w;
-            sy[l] += y * w;
-            sz[l] += z * w;
-            pairs[l] += valid;
+            acc.add(l, [x, y, z], iv, valid / (lk + lp).max(f32::MIN_POSITIVE), valid);
         }
     }
-    let (mut ux, mut uy, mut uz, mut good) = ([0f32; L], [0f32; L], [0f32; L], [false; L]);
-    for l in 0..L {
-        let sum2 = sx[l] * sx[l] + sy[l] * sy[l] + sz[l] * sz[l];
-        good[l] = (pairs[l] >= min_pairs) & (sum2 > 0.0) & sum2.is_finite();
-        // One more Newton step for `n` itself (it is the output).
-        let inv_len = rsqrt_step(sum2, rsqrt(sum2.max(f32::MIN_POSITIVE)));
-        (ux[l], uy[l], uz[l]) = (sx[l] * inv_len, sy[l] * inv_len, sz[l] * inv_len);
+    acc.finish(min_pairs)
+}
+
+impl Acc {
+    /// Eq. 2-3 from the sums: the unit normal `(nx, ny, nz)` and `n_rho` per lane, zeros where a
+    /// cell has fewer than `min_pairs` pairs or a degenerate sum.
+    #[inline(always)]
+    fn finish(&self, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
+        let ([sx, sy, sz], [ex, ey, ez], pairs) = (&self.s, &self.e, &self.pairs);
+        let (mut ux, mut uy, mut uz, mut good) = ([0f32; L], [0f32; L], [0f32; L], [false; L]);
+        for l in 0..L {
+            let sum2 = sx[l] * sx[l] + sy[l] * sy[l] + sz[l] * sz[l];
+            good[l] = (pairs[l] >= min_pairs) & (sum2 > 0.0) & sum2.is_finite();
+            // One more Newton step for `n` itself (it is the output).
+            let inv_len = rsqrt_step(sum2, rsqrt(sum2.max(f32::MIN_POSITIVE)));
+            (ux[l], uy[l], uz[l]) = (sx[l] * inv_len, sy[l] * inv_len, sz[l] * inv_len);
+        }
+        // Eq. 3: mean cosine similarity between n and its generating normals.
+        let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+        for l in 0..L {
+            let q = (ux[l] * ex[l] + uy[l] * ey[l] + uz[l] * ez[l]) / pairs[l];
+            (ox[l], oy[l], oz[l], rho[l]) = if good[l] { (ux[l], uy[l], uz[l], q) } else { (0.0, 0.0, 0.0, 0.0) };
+        }
+        (ox, oy, oz, rho)
     }
-    // Eq. 3: mean cosine similarity between n and its generating normals.
-    let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
-    for l in 0..L {
-        let q = (ux[l] * ex[l] + uy[l] * ey[l] + uz[l] * ez[l]) / pairs[l];
-        (ox[l], oy[l], oz[l], rho[l]) = if good[l] { (ux[l], uy[l], uz[l], q) } else { (0.0, 0.0, 0.0, 0.0) };
-    }
-    (ox, oy, oz, rho)
 }
 
 /// One Newton step `y (1.5 - x y^2 / 2)` towards `1 / sqrt(x)` from the estimate `y`.

@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 
-use crate::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates};
+use crate::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_with};
 use crate::error::{ClassifyError, Result, check_cloud, is_valid};
 use crate::features::{FeatureParams, Features, compute_features};
 use crate::neighbours::{GridView, NeighbourParams, Wrap, detect_wrap};
@@ -139,8 +139,9 @@ impl Nitsch {
         if self.params.cluster {
             self.candidate.clear();
             self.candidate.extend(self.features.g_rho.iter().map(|&g| g >= thr && g > 0.0));
-            cluster_candidates(
+            cluster_candidates_with(
                 &view,
+                Some(self.features.valid()),
                 &self.candidate,
                 &self.features.normal,
                 &self.params.clustering,

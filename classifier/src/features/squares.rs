@@ -1,0 +1,191 @@
+//! The fast path of the features: per-edge and per-triangle quantities computed once per grid
+//! square and shared by the cells that use them.
+//!
+//! Every pair normal `n_i = d_i x d_(i-1)` of a cell is the cross product of a triangle of the cell
+//! and two neighbours that are themselves grid neighbours, that is half of one of the 4 grid squares
+//! around the cell. Each square `(s, c)` with corners `a = (s, c)`, `b = (s, c + 1)`,
+//! `u = (s + 1, c)`, `v = (s + 1, c + 1)` holds 4 such triangles, and each of them is a pair normal
+//! of exactly 2 cells (the two ends of the diagonal it lies on, where the cross product is the same
+//! vector: cyclic vertex orders give the same cross product):
+//!
+//! | triangle | cross product | pair of `a` / `b` | pair of `u` / `v` |
+//! |---|---|---|---|
+//! | `T0 = (a, v, u)` | `(v - a) x (u - a)` | `d2 x d1` of `a` | `d7 x d6` of `v` |
+//! | `T1 = (a, b, v)` | `(b - a) x (v - a)` | `d3 x d2` of `a` | `d6 x d5` of `v` |
+//! | `T2 = (b, v, u)` | `(v - b) x (u - b)` | `d1 x d8` of `b` | `d4 x d3` of `u` |
+//! | `T3 = (b, u, a)` | `(u - b) x (a - b)` | `d8 x d7` of `b` | `d5 x d4` of `u` |
+//!
+//! So a row of squares computes 4 cross products, their squared lengths and reciprocal lengths,
+//! and the lengths of the vertical, diagonal and anti-diagonal edges once, instead of 8 pair
+//! normals and 8 neighbour distances per cell. Edge lengths are the same bits as a per-cell
+//! computation (`q - p` is exactly `-(p - q)`); a triangle's cross product computed from its other
+//! corner differs in rounding only (the per-cell reference test bounds the features within 1e-5).
+
+// Lane arrays are indexed by field and lane on purpose (vectorized across columns).
+#![allow(clippy::needless_range_loop)]
+
+use super::{Acc, L, Tests, rsqrt};
+
+/// Floats stored per triangle: the cross product `x, y, z`, its squared length and `1 / |n|`.
+const TRI: usize = 5;
+/// Fields of a square: 4 triangles, then the edge lengths.
+pub(super) const SQUARE_FIELDS: usize = 4 * TRI + 3;
+/// Length of the vertical edge `|u - a|`.
+const VERTICAL: usize = 4 * TRI;
+/// Length of the diagonal edge `|v - a|`.
+const DIAGONAL: usize = 4 * TRI + 1;
+/// Length of the anti-diagonal edge `|u - b|`.
+const ANTI: usize = 4 * TRI + 2;
+
+/// The squares of columns `j L - 1 .. j L + L` of chunk `j`, every field as `L + 1` lanes: lane
+/// `l + 1` is column `j L + l`, and lane 0 repeats the last square of chunk `j - 1`, so that the
+/// fast path reads the squares at `c` and at `c - 1` of `L` cells as plain loads (no shuffles).
+/// (One array per chunk, not one row-long array per field: the compiler vectorizes stores into
+/// one array, while 23 separate row slices might overlap as far as it can tell, and it then
+/// writes lane by lane, 10 times slower.)
+pub(super) type SquareChunk = [[f32; L + 1]; SQUARE_FIELDS];
+
+/// `L` consecutive values of `a` from `i` on.
+#[inline(always)]
+fn at(a: &[f32], i: usize) -> [f32; L] {
+    a[i..i + L].try_into().expect("L cells")
+}
+
+/// `q - p` in lane `l`.
+#[inline(always)]
+fn sub(q: &[[f32; L]; 3], p: &[[f32; L]; 3], l: usize) -> [f32; 3] {
+    [q[0][l] - p[0][l], q[1][l] - p[1][l], q[2][l] - p[2][l]]
+}
+
+/// `|d|` as glam's `length`: `sqrt((x * x + y * y) + z * z)`.
+#[inline(always)]
+fn length(d: [f32; 3]) -> f32 {
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}
+
+/// Chunks of a square row for `cols` columns.
+pub(super) fn chunks(cols: usize) -> usize {
+    cols.div_ceil(L)
+}
+
+/// Fills `out` ([`chunks`] long) with the triangles and edge lengths of the squares between rows
+/// `s` and `s + 1` of the plane (`xs`, `ys`, `zs`: row-major, padded with at least `L + 1` values
+/// past the last row). Squares past column `cols - 2`, or with a corner without a return, get
+/// meaningless values; the fast path never reads them.
+#[inline(always)]
+pub(super) fn square_row(xs: &[f32], ys: &[f32], zs: &[f32], s: usize, cols: usize, out: &mut [SquareChunk]) {
+    for (j, o) in out[..chunks(cols)].iter_mut().enumerate() {
+        let (ia, iu) = (s * cols + j * L, (s + 1) * cols + j * L);
+        let load = |i: usize| [at(xs, i), at(ys, i), at(zs, i)];
+        let (a, b, u, v) = (load(ia), load(ia + 1), load(iu), load(iu + 1));
+        for l in 0..L {
+            let (ua, va, ba) = (sub(&u, &a, l), sub(&v, &a, l), sub(&b, &a, l));
+            let (vb, ub, ab) = (sub(&v, &b, l), sub(&u, &b, l), sub(&a, &b, l));
+            for (t, (p, q)) in [(va, ua), (ba, va), (vb, ub), (ub, ab)].into_iter().enumerate() {
+                let x = p[1] * q[2] - p[2] * q[1];
+                let y = p[2] * q[0] - p[0] * q[2];
+                let z = p[0] * q[1] - p[1] * q[0];
+                let nl2 = x * x + y * y + z * z;
+                o[t * TRI][l + 1] = x;
+                o[t * TRI + 1][l + 1] = y;
+                o[t * TRI + 2][l + 1] = z;
+                o[t * TRI + 3][l + 1] = nl2;
+                o[t * TRI + 4][l + 1] = rsqrt(nl2.max(f32::MIN_POSITIVE));
+            }
+            o[VERTICAL][l + 1] = length(ua);
+            o[DIAGONAL][l + 1] = length(va);
+            o[ANTI][l + 1] = length(ub);
+        }
+    }
+    // Lane 0: the previous chunk's last square.
+    for j in 1..chunks(cols) {
+        let (done, rest) = out.split_at_mut(j);
+        for (o, p) in rest[0].iter_mut().zip(&done[j - 1]) {
+            o[0] = p[L];
+        }
+    }
+}
+
+/// Fills `out[..cols - 1]` with the lengths of the horizontal edges `|P(r, c + 1) - P(r, c)|` of row `r`.
+#[inline(always)]
+pub(super) fn horizontal_row(xs: &[f32], ys: &[f32], zs: &[f32], r: usize, cols: usize, out: &mut [f32]) {
+    let row = r * cols..(r + 1) * cols;
+    let (x, y, z) = (&xs[row.clone()], &ys[row.clone()], &zs[row]);
+    for c in 0..cols - 1 {
+        out[c] = length([x[c + 1] - x[c], y[c + 1] - y[c], z[c + 1] - z[c]]);
+    }
+}
+
+/// Where cell `(r, c)` finds its pair `k` (`d_(k+1) x d_k`, `d_0` = `d_8`) in the square rows below
+/// (`false`) or above (`true`) it: triangle index and column offset (module table).
+const PAIR_TRIANGLE: [(bool, usize, usize); 8] = [
+    (true, 2, 1),  // d1 x d8: T2 of square (r, c - 1)
+    (true, 0, 0),  // d2 x d1: T0 of square (r, c)
+    (true, 1, 0),  // d3 x d2: T1 of square (r, c)
+    (false, 2, 0), // d4 x d3: T2 of square (r - 1, c)
+    (false, 3, 0), // d5 x d4: T3 of square (r - 1, c)
+    (false, 1, 1), // d6 x d5: T1 of square (r - 1, c - 1)
+    (false, 0, 1), // d7 x d6: T0 of square (r - 1, c - 1)
+    (true, 3, 1),  // d8 x d7: T3 of square (r, c - 1)
+];
+
+/// Field `f` of the `L` squares from column `j L - back` on (`back` 0 or 1).
+#[inline(always)]
+fn window(chunk: &SquareChunk, f: usize, back: usize) -> [f32; L] {
+    chunk[f][1 - back..1 - back + L].try_into().expect("L lanes")
+}
+
+/// Accumulates Eq. 2 and the sum of unit pair normals for the `L` cells from `(r, c0)` on
+/// (`c0 = j L`, `j >= 1`), all with their 8 direct neighbours present, from the square rows
+/// `below` (`r - 1`) and `above` (`r`) and the horizontal edge lengths `horizontal` of row `r`.
+/// The same operations per pair as [`super::lane_features`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn dense_block(
+    ranges: &[f32],
+    below: &[SquareChunk],
+    above: &[SquareChunk],
+    horizontal: &[f32],
+    r: usize,
+    j: usize,
+    cols: usize,
+    tests: &Tests,
+) -> Acc {
+    let c0 = j * L;
+    let (below, above) = (&below[j], &above[j]);
+    // |d_k| for d1..d8, from the squares and row edges that hold them.
+    let len = [
+        window(above, VERTICAL, 0),
+        window(above, DIAGONAL, 0),
+        at(horizontal, c0),
+        window(below, ANTI, 0),
+        window(below, VERTICAL, 0),
+        window(below, DIAGONAL, 1),
+        at(horizontal, c0 - 1),
+        window(above, ANTI, 1),
+    ];
+    let i0 = r * cols + c0;
+    let pr = at(ranges, i0);
+    let mut ok = [[0f32; L]; 8];
+    for (k, &(dr, dc)) in super::OFFSETS.iter().enumerate() {
+        let qr = at(ranges, (i0 as isize + dr * cols as isize + dc) as usize);
+        for l in 0..L {
+            ok[k][l] = if tests.keep_len(k, len[k][l], qr[l], pr[l]) { 1.0 } else { 0.0 };
+        }
+    }
+    let mut acc = Acc::default();
+    for (k, &(up, t, back)) in PAIR_TRIANGLE.iter().enumerate() {
+        let chunk = if up { above } else { below };
+        let field = |f: usize| window(chunk, f, back);
+        let (x, y, z) = (field(t * TRI), field(t * TRI + 1), field(t * TRI + 2));
+        let (nl2, inv) = (field(t * TRI + 3), field(t * TRI + 4));
+        let p = (k + 7) % 8;
+        for l in 0..L {
+            let (lk, lp) = (len[k][l], len[p][l]);
+            let tt = lk * lp;
+            let valid = if nl2[l] > 1e-24 * tt * tt { ok[k][l] * ok[p][l] } else { 0.0 };
+            acc.add(l, [x[l], y[l], z[l]], valid * inv[l], valid / (lk + lp).max(f32::MIN_POSITIVE), valid);
+        }
+    }
+    acc
+}
