@@ -224,30 +224,45 @@ fn grid_accumulation_uses_poses_across_frames() {
     assert!(e.pooled.fpr() < 0.2, "{:?}", e.pooled);
 }
 
-#[test]
-fn wide_low_clusters_outside_the_ground_area_are_ground_high_ones_are_not() {
+/// A 3 x 200 grid whose first 150 cells of row 0 are a road strip 5 m ahead (x = 5 m, z = 0,
+/// 0.1 m apart); every other cell has no return. Returns the points and the column count.
+fn road_rows() -> (Vec<Vec3>, usize) {
     let (rows, cols) = (3, 200);
     let mut pts = vec![Vec3::NAN; rows * cols];
     for (c, p) in pts[..150].iter_mut().enumerate() {
         *p = Vec3::new(5.0, -7.5 + 0.1 * c as f32, 0.0);
     }
+    (pts, cols)
+}
+
+/// Clusters every return of the grid `pts` (`cols` columns, normals `+z`) and applies the cluster
+/// rules: the number of clusters and the ground decision per cell.
+fn cluster_and_decide(pts: &[Vec3], cols: usize, params: &ClusterParams) -> (usize, Vec<bool>) {
+    let rows = pts.len() / cols;
+    let ranges: Vec<f32> = pts.iter().map(|p| p.length()).collect();
+    let view =
+        classifier::neighbours::GridView { points: pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
+    let candidate: Vec<bool> = pts.iter().map(|p| p.is_finite()).collect();
+    let normals = vec![Vec3::Z; pts.len()];
+    let returns = candidate.iter().filter(|&&c| c).count();
+    let mut ws = ClusterWorkspace::default();
+    cluster_candidates(&view, &candidate, &normals, params, &mut ws);
+    let mut ground = vec![false; pts.len()];
+    ws.decide(pts, returns, params, &mut ground);
+    (ws.cluster_count(), ground)
+}
+
+#[test]
+fn wide_low_clusters_outside_the_ground_area_are_ground_high_ones_are_not() {
+    let (mut pts, cols) = road_rows();
     for c in 0..20 {
         pts[cols + c] = Vec3::new(60.0, -10.0 + c as f32, -0.5);
         pts[2 * cols + c] = Vec3::new(60.0, -10.0 + c as f32, 3.0);
     }
-    let ranges: Vec<f32> = pts.iter().map(|p| p.length()).collect();
-    let view =
-        classifier::neighbours::GridView { points: &pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
-    let candidate: Vec<bool> = pts.iter().map(|p| p.is_finite()).collect();
-    let normals = vec![Vec3::Z; pts.len()];
-    let returns = candidate.iter().filter(|&&c| c).count();
     for (extent, low_expected) in [(10.0, true), (0.0, false)] {
         let params = ClusterParams { min_large_extent_m: extent, ..Default::default() };
-        let mut ws = ClusterWorkspace::default();
-        cluster_candidates(&view, &candidate, &normals, &params, &mut ws);
-        assert_eq!(ws.cluster_count(), 3);
-        let mut ground = vec![false; pts.len()];
-        ws.decide(&pts, returns, &params, &mut ground);
+        let (clusters, ground) = cluster_and_decide(&pts, cols, &params);
+        assert_eq!(clusters, 3);
         assert!(ground[..150].iter().all(|&g| g), "the largest cluster is ground");
         assert!(ground[cols..cols + 20].iter().all(|&g| g == low_expected), "low strip, extent {extent}");
         assert!(ground[2 * cols..2 * cols + 20].iter().all(|&g| !g), "raised strip, extent {extent}");
@@ -259,29 +274,15 @@ fn the_default_extent_accepts_far_ring_segments_longer_than_object_tops() {
     // Outside the ground area, 60 m ahead and 0.5 m below the road: a ring segment of 8 points
     // 1 m apart (7 m long, far terrain) and one of 5 points 1 m apart (4 m: the size of an object top).
     assert_eq!(ClusterParams::default().min_large_extent_m, 6.0);
-    let (rows, cols) = (3, 200);
-    let mut pts = vec![Vec3::NAN; rows * cols];
-    for (c, p) in pts[..150].iter_mut().enumerate() {
-        *p = Vec3::new(5.0, -7.5 + 0.1 * c as f32, 0.0);
-    }
+    let (mut pts, cols) = road_rows();
     for c in 0..8 {
         pts[cols + c] = Vec3::new(60.0, -20.0 + c as f32, -0.5);
     }
     for c in 0..5 {
         pts[2 * cols + 100 + c] = Vec3::new(80.0, 10.0 + c as f32, -0.5);
     }
-    let ranges: Vec<f32> = pts.iter().map(|p| p.length()).collect();
-    let view =
-        classifier::neighbours::GridView { points: &pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
-    let candidate: Vec<bool> = pts.iter().map(|p| p.is_finite()).collect();
-    let normals = vec![Vec3::Z; pts.len()];
-    let returns = candidate.iter().filter(|&&c| c).count();
-    let params = ClusterParams::default();
-    let mut ws = ClusterWorkspace::default();
-    cluster_candidates(&view, &candidate, &normals, &params, &mut ws);
-    assert_eq!(ws.cluster_count(), 3);
-    let mut ground = vec![false; pts.len()];
-    ws.decide(&pts, returns, &params, &mut ground);
+    let (clusters, ground) = cluster_and_decide(&pts, cols, &ClusterParams::default());
+    assert_eq!(clusters, 3);
     assert!(ground[..150].iter().all(|&g| g), "the largest cluster is ground");
     assert!(ground[cols..cols + 8].iter().all(|&g| g), "7 m segment");
     assert!(ground[2 * cols + 100..2 * cols + 105].iter().all(|&g| !g), "4 m segment");
