@@ -165,6 +165,9 @@ pub struct ClusterWorkspace {
     members: Vec<u32>,
     /// Ground-area squares: (sum z, count) per square in a bounding box.
     area: Vec<(f32, u32)>,
+    /// Per area square, with a border of one square around the area: the mean height of the
+    /// ground-area points in the 3 x 3 squares around it and their count (`NOT_YET` until needed).
+    near: Vec<(f32, u32)>,
     /// Decision per root.
     root_ground: Vec<bool>,
     /// Whether each cell holds a return.
@@ -179,9 +182,31 @@ pub struct ClusterWorkspace {
 
 const NONE: u32 = u32::MAX;
 
+/// A count of [`ClusterWorkspace`]'s `near` squares not computed yet.
+const NOT_YET: u32 = u32::MAX;
+
+/// The mean height of the ground-area points in the 3 x 3 squares around square `(x, y)` of the
+/// `nx` x `ny` area (sums of height and count per square), and their count (mean 0 without any).
+#[inline]
+fn near_mean(area: &[(f32, u32)], nx: usize, ny: usize, x: isize, y: isize) -> (f32, u32) {
+    let (mut zs, mut cnt) = (0.0f32, 0u32);
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let (xx, yy) = (x + dx, y + dy);
+            if xx >= 0 && yy >= 0 && (xx as usize) < nx && (yy as usize) < ny {
+                let e = area[yy as usize * nx + xx as usize];
+                zs += e.0;
+                cnt += e.1;
+            }
+        }
+    }
+    (if cnt > 0 { zs / cnt as f32 } else { 0.0 }, cnt)
+}
+
 /// `v.floor() as isize`, bit for bit (saturating, NaN to 0), without a call to `floorf` (the
 /// baseline x86-64 target has no rounding instruction): truncation toward zero, one less where
-/// that rounded a negative value up.
+/// that rounded a negative value up (a subtraction, not a branch: points on either side of the
+/// area's corner would mispredict it).
 #[inline]
 fn floor_isize(v: f32) -> isize {
     let t = v as isize;
@@ -475,30 +500,49 @@ impl ClusterWorkspace {
             (self.inside[r], self.height_sum[r], self.outside_sum[r]) = (0, 0.0, Vec3::ZERO);
             self.root_ground[r] = false;
         }
+        // The 3 x 3 sums around a square are found once per square, when a point first needs
+        // them (most points of a cluster share squares), not once per point.
+        let wx = nx + 2;
+        self.near.clear();
+        self.near.resize(wx * (ny + 2), (0.0, NOT_YET));
+        // Consecutive members mostly share a root: its sums stay in registers for the run.
+        let (mut run, mut inside, mut height, mut outside) = (NONE, 0u32, 0f32, Vec3::ZERO);
         for &i in &self.members {
             let root = self.parent[i as usize];
             if root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points {
                 continue;
             }
+            if root != run {
+                if run != NONE {
+                    let r = run as usize;
+                    (self.inside[r], self.height_sum[r], self.outside_sum[r]) = (inside, height, outside);
+                }
+                run = root;
+                let r = root as usize;
+                (inside, height, outside) = (self.inside[r], self.height_sum[r], self.outside_sum[r]);
+            }
             let p = points[i as usize];
             let (x, y) = square(p);
-            let (mut zs, mut cnt) = (0.0f32, 0u32);
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let (xx, yy) = (x + dx, y + dy);
-                    if xx >= 0 && yy >= 0 && (xx as usize) < nx && (yy as usize) < ny {
-                        let e = self.area[yy as usize * nx + xx as usize];
-                        zs += e.0;
-                        cnt += e.1;
-                    }
+            // Squares beyond the border have no area square around them.
+            let (mean, cnt) = if (-1..=nx as isize).contains(&x) && (-1..=ny as isize).contains(&y) {
+                let k = (y + 1) as usize * wx + (x + 1) as usize;
+                if self.near[k].1 == NOT_YET {
+                    self.near[k] = near_mean(&self.area, nx, ny, x, y);
                 }
-            }
-            if cnt > 0 {
-                self.inside[root as usize] += 1;
-                self.height_sum[root as usize] += p.z - zs / cnt as f32;
+                self.near[k]
             } else {
-                self.outside_sum[root as usize] += p;
+                (0.0, 0)
+            };
+            if cnt > 0 {
+                inside += 1;
+                height += p.z - mean;
+            } else {
+                outside += p;
             }
+        }
+        if run != NONE {
+            let r = run as usize;
+            (self.inside[r], self.height_sum[r], self.outside_sum[r]) = (inside, height, outside);
         }
         let (zsum, zcount) = self.area.iter().fold((0f64, 0u64), |(a, b), e| (a + f64::from(e.0), b + u64::from(e.1)));
         let ground_mean_z = (zsum / zcount.max(1) as f64) as f32;

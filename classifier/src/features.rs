@@ -115,11 +115,11 @@ struct Soa {
     y: Vec<f32>,
     z: Vec<f32>,
     valid: Vec<bool>,
-    /// Per column of the row being processed: returns in the rows below, at and above.
-    column_valid: Vec<bool>,
-    /// The two square rows around the row being processed ([`squares::square_row`]), by parity.
+    /// The tile's two square rows around the row being processed ([`squares::square_row`]), by parity.
     squares: [Vec<squares::SquareChunk>; 2],
-    /// Horizontal edge lengths of the row being processed.
+    /// Per square row: the last square left of the tile (lane 0 of the tile's first chunk).
+    edge: Vec<[f32; squares::SQUARE_FIELDS]>,
+    /// Horizontal edge lengths of the row being processed, by column.
     horizontal: Vec<f32>,
 }
 
@@ -249,19 +249,75 @@ fn compute_features_avx512(view: &GridView<'_>, params: &FeatureParams, out: &mu
     compute_features_body(view, params, out);
 }
 
+/// Square chunks per tile of the fast path: the tile's two square rows (about 25 kB) stay in the
+/// level-1 cache while the tile's cells go up the rows, instead of a whole row's squares (400 kB)
+/// passing through the level-2 cache for every row.
+const TILE: usize = 8;
+
+/// The plane as the blocks read it.
+#[derive(Clone, Copy)]
+struct Plane<'a> {
+    view: &'a GridView<'a>,
+    x: &'a [f32],
+    y: &'a [f32],
+    z: &'a [f32],
+    valid: &'a [bool],
+    tests: Tests,
+    min_pairs: f32,
+}
+
+/// The per-cell outputs of [`Features`], as slices.
+struct Outputs<'a> {
+    normal: &'a mut [Vec3],
+    n_rho: &'a mut [f32],
+    g_rho: &'a mut [f32],
+}
+
+impl Outputs<'_> {
+    /// Writes the `m` cells from `i0` on: the features of the lanes with `cell_ok`, zeros elsewhere
+    /// (selects, not branches: the lanes vectorize).
+    #[inline(always)]
+    fn write(&mut self, i0: usize, m: usize, cell_ok: &[bool; L], f: &Cells) {
+        let ([nx, ny, nz], rho) = (&f.n, &f.rho);
+        let (mut ox, mut oy, mut oz, mut orho, mut og) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+        for l in 0..L {
+            let keep = cell_ok[l];
+            (ox[l], oy[l]) = (if keep { nx[l] } else { 0.0 }, if keep { ny[l] } else { 0.0 });
+            (oz[l], orho[l]) = (if keep { nz[l] } else { 0.0 }, if keep { rho[l] } else { 0.0 });
+            og[l] = oz[l] * orho[l];
+        }
+        for (l, n) in self.normal[i0..i0 + m].iter_mut().enumerate() {
+            *n = Vec3::new(ox[l], oy[l], oz[l]);
+        }
+        self.n_rho[i0..i0 + m].copy_from_slice(&orho[..m]);
+        self.g_rho[i0..i0 + m].copy_from_slice(&og[..m]);
+    }
+
+    /// Zeros for the `m` cells from `i0` on.
+    #[inline(always)]
+    fn zero(&mut self, i0: usize, m: usize) {
+        self.normal[i0..i0 + m].fill(Vec3::ZERO);
+        self.n_rho[i0..i0 + m].fill(0.0);
+        self.g_rho[i0..i0 + m].fill(0.0);
+    }
+}
+
 /// The body of [`compute_features`], inlined into each instruction-set variant.
+///
+/// Blocks of `L` cells of a row clear of the grid's edges take the fast path ([`squares`]), in
+/// tiles of [`TILE`] blocks going up the rows; the others (first and last rows and blocks, grids
+/// too small) take the general search.
 #[inline(always)]
 fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     let (rows, cols) = (view.rows, view.cols);
     let n = rows * cols;
     out.resize(n);
-    let soa = &mut out.soa;
-    // Padded past the last row: the square rows read `L + 1` values beyond their last column.
+    let Features { normal, n_rho, g_rho, soa } = out;
+    let mut outputs = Outputs { normal: &mut normal[..n], n_rho: &mut n_rho[..n], g_rho: &mut g_rho[..n] };
     for a in [&mut soa.x, &mut soa.y, &mut soa.z] {
-        a.resize(n + L + 1, f32::NAN);
+        a.resize(n, f32::NAN);
     }
     soa.valid.resize(n, false);
-    soa.column_valid.resize(cols, false);
     let (xs, ys, zs, valid) = (&mut soa.x[..n], &mut soa.y[..n], &mut soa.z[..n], &mut soa.valid[..n]);
     for (i, p) in view.points[..n].iter().enumerate() {
         // `is_valid` without short-circuit branches, so that the loop vectorizes.
@@ -276,120 +332,133 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         max_d: params.max_neighbour_distance_m,
         keep: [up, up, lat, other, other, other, lat, up],
     };
-    // The fast path needs a square row on either side of the row and blocks clear of both edges.
-    let fast = rows >= 3 && cols >= L + 2;
-    if fast {
-        for sq in &mut soa.squares {
-            sq.resize(squares::chunks(cols), [[0.0; L + 1]; squares::SQUARE_FIELDS]);
-        }
-        soa.horizontal.resize(cols, 0.0);
-    }
-    let min_pairs = params.min_valid_pairs as f32;
-    let ranges = &view.ranges[..n];
+    let plane = Plane {
+        view,
+        x: &soa.x[..n],
+        y: &soa.y[..n],
+        z: &soa.z[..n],
+        valid: &soa.valid[..n],
+        tests,
+        min_pairs: params.min_valid_pairs as f32,
+    };
     let mut lanes =
         Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
+    // The fast path needs a row on either side and blocks clear of both edges.
+    let inner = if rows >= 3 && cols > L { squares::inner_chunks(cols) } else { 0 };
+    let general = |r: usize| if r == 0 || r + 1 == rows || inner < 2 { 0..0 } else { 1..inner };
     for r in 0..rows {
-        let interior_row = r > 0 && r + 1 < rows;
-        if interior_row {
-            let row = r * cols..(r + 1) * cols;
-            let (below, at, above) = (&soa.valid[row.start - cols..], &soa.valid[row.clone()], &soa.valid[row.end..]);
-            for (c, v) in soa.column_valid.iter_mut().enumerate() {
-                *v = below[c] & at[c] & above[c];
-            }
-        }
-        if interior_row && fast {
-            // Square rows r - 1 and r (the first computed at row 1, each later one once).
-            let (xs, ys, zs) = (&soa.x[..], &soa.y[..], &soa.z[..]);
-            if r == 1 {
-                squares::square_row(xs, ys, zs, 0, cols, &mut soa.squares[0]);
-            }
-            squares::square_row(xs, ys, zs, r, cols, &mut soa.squares[r % 2]);
-            squares::horizontal_row(xs, ys, zs, r, cols, &mut soa.horizontal);
-        }
+        let skip = general(r);
         let mut c0 = 0;
         while c0 < cols {
-            let m = (cols - c0).min(L);
-            let i0 = r * cols + c0;
-            // The fast path needs all 3 x (L + 2) cells around the L cells to hold returns.
-            let dense = interior_row
-                && m == L
-                && c0 > 0
-                && c0 + L < cols
-                && soa.column_valid[c0 - 1..c0 + L + 1].iter().fold(true, |a, &v| a & v);
-            if !dense && !soa.valid[i0..i0 + m].iter().any(|&v| v) {
-                // No return in these cells (sky): no features.
-                out.normal[i0..i0 + m].fill(Vec3::ZERO);
-                out.n_rho[i0..i0 + m].fill(0.0);
-                out.g_rho[i0..i0 + m].fill(0.0);
-                c0 += m;
+            if skip.contains(&(c0 / L)) {
+                c0 = skip.end * L;
                 continue;
             }
-            let mut cell_ok = [true; L];
-            let (nx, ny, nz, rho) = if interior_row && fast && m == L && c0 > 0 && c0 + L < cols {
-                let (below, above) = (&soa.squares[(r - 1) % 2], &soa.squares[r % 2]);
-                let acc = squares::dense_block(ranges, below, above, &soa.horizontal, r, c0 / L, cols, &tests);
-                let mut f = acc.finish(min_pairs);
-                if !dense {
-                    // Some cells lack a direct neighbour: those again by the general search.
-                    let cv = &soa.column_valid[c0 - 1..c0 + L + 1];
-                    let mut general = [false; L];
-                    for l in 0..L {
-                        if !(cv[l] & cv[l + 1] & cv[l + 2]) {
-                            general[l] = true;
-                            cell_ok[l] = fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
-                        }
-                    }
-                    let g = lane_features(&lanes, min_pairs);
-                    for l in 0..L {
-                        if general[l] {
-                            (f.0[l], f.1[l], f.2[l], f.3[l]) = (g.0[l], g.1[l], g.2[l], g.3[l]);
-                        }
-                    }
-                }
-                f
-            } else {
-                for l in 0..L {
-                    cell_ok[l] = l < m && fill_one(view, soa, ranges, r, c0 + l, l, &tests, &mut lanes);
-                }
-                lane_features(&lanes, min_pairs)
-            };
-            // Cells without features get zeros (selects, not branches: the lanes vectorize).
-            let (mut ox, mut oy, mut oz, mut orho, mut og) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L], [0f32; L]);
-            for l in 0..L {
-                let keep = cell_ok[l];
-                (ox[l], oy[l]) = (if keep { nx[l] } else { 0.0 }, if keep { ny[l] } else { 0.0 });
-                (oz[l], orho[l]) = (if keep { nz[l] } else { 0.0 }, if keep { rho[l] } else { 0.0 });
-                og[l] = oz[l] * orho[l];
-            }
-            for (l, n) in out.normal[i0..i0 + m].iter_mut().enumerate() {
-                *n = Vec3::new(ox[l], oy[l], oz[l]);
-            }
-            out.n_rho[i0..i0 + m].copy_from_slice(&orho[..m]);
-            out.g_rho[i0..i0 + m].copy_from_slice(&og[..m]);
+            let m = (cols - c0).min(L);
+            general_block(&plane, r, c0, m, &mut lanes, &mut outputs);
             c0 += m;
+        }
+    }
+    if inner < 2 {
+        return;
+    }
+    soa.horizontal.resize(cols, 0.0);
+    soa.edge.resize(rows - 1, [0.0; squares::SQUARE_FIELDS]);
+    for sq in &mut soa.squares {
+        sq.resize(TILE, [[0.0; L + 1]; squares::SQUARE_FIELDS]);
+    }
+    let (horizontal, edge, ring) = (&mut soa.horizontal, &mut soa.edge, &mut soa.squares);
+    let xyz = [plane.x, plane.y, plane.z];
+    for t0 in (0..inner).step_by(TILE) {
+        let tile = t0..(t0 + TILE).min(inner);
+        squares::square_row(xyz, 0, cols, tile.clone(), &mut edge[0], &mut ring[0]);
+        for r in 1..rows - 1 {
+            squares::square_row(xyz, r, cols, tile.clone(), &mut edge[r], &mut ring[r % 2]);
+            squares::horizontal_row(xyz, r, cols, tile.start.max(1) * L - 1..tile.end * L, horizontal);
+            let (below, above) = (&ring[(r - 1) % 2], &ring[r % 2]);
+            for j in tile.start.max(1)..tile.end {
+                let (b, a) = (&below[j - tile.start], &above[j - tile.start]);
+                fast_block(&plane, b, a, horizontal, r, j, &mut lanes, &mut outputs);
+            }
         }
     }
 }
 
-/// Offsets of cell `(r, c)` into lane `l` by the general neighbour search; false if it has no return.
+/// The `m` cells of row `r` from column `c0` on, by the general neighbour search.
+#[inline(always)]
+fn general_block(plane: &Plane<'_>, r: usize, c0: usize, m: usize, lanes: &mut Lanes, out: &mut Outputs<'_>) {
+    let i0 = r * plane.view.cols + c0;
+    if !plane.valid[i0..i0 + m].iter().any(|&v| v) {
+        // No return in these cells (sky): no features.
+        out.zero(i0, m);
+        return;
+    }
+    let mut cell_ok = [false; L];
+    for l in 0..m {
+        cell_ok[l] = fill_one(plane, r, c0 + l, l, lanes);
+    }
+    let mut f = Cells::default();
+    lane_features(lanes, plane.min_pairs, &mut f);
+    out.write(i0, m, &cell_ok, &f);
+}
+
+/// The `L` cells of row `r` in chunk `j` (clear of the grid's edges) from the squares of the chunk
+/// below and above the row; cells that lack a direct neighbour again by the general search.
 #[allow(clippy::too_many_arguments)]
-#[inline]
-fn fill_one(
-    view: &GridView<'_>,
-    soa: &Soa,
-    ranges: &[f32],
+#[inline(always)]
+fn fast_block(
+    plane: &Plane<'_>,
+    below: &squares::SquareChunk,
+    above: &squares::SquareChunk,
+    horizontal: &[f32],
     r: usize,
-    c: usize,
-    l: usize,
-    tests: &Tests,
+    j: usize,
     lanes: &mut Lanes,
-) -> bool {
+    out: &mut Outputs<'_>,
+) {
+    let cols = plane.view.cols;
+    let (c0, i0) = (j * L, r * cols + j * L);
+    // Columns c0 - 1 ..= c0 + L with returns in the rows below, at and above.
+    let (vb, va, vu) = (&plane.valid[i0 - cols - 1..], &plane.valid[i0 - 1..], &plane.valid[i0 + cols - 1..]);
+    let mut cv = [false; L + 2];
+    for c in 0..L + 2 {
+        cv[c] = vb[c] & va[c] & vu[c];
+    }
+    let dense = cv.iter().fold(true, |a, &v| a & v);
+    if !dense && !plane.valid[i0..i0 + L].iter().any(|&v| v) {
+        out.zero(i0, L);
+        return;
+    }
+    let acc = squares::dense_block(plane.view.ranges, below, above, horizontal, r, j, cols, &plane.tests);
+    let mut f = Cells::default();
+    acc.finish(plane.min_pairs, &mut f);
+    let mut cell_ok = [true; L];
+    if !dense {
+        // Some cells lack a direct neighbour: those again by the general search.
+        let mut general = [false; L];
+        for l in 0..L {
+            if !(cv[l] & cv[l + 1] & cv[l + 2]) {
+                general[l] = true;
+                cell_ok[l] = fill_one(plane, r, c0 + l, l, lanes);
+            }
+        }
+        let mut g = Cells::default();
+        lane_features(lanes, plane.min_pairs, &mut g);
+        f.take(&general, &g);
+    }
+    out.write(i0, L, &cell_ok, &f);
+}
+
+/// Offsets of cell `(r, c)` into lane `l` by the general neighbour search; false if it has no return.
+#[inline]
+fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &mut Lanes) -> bool {
+    let (view, tests, ranges) = (plane.view, &plane.tests, plane.view.ranges);
     let i = r * view.cols + c;
-    let nb = if soa.valid[i] { view.neighbours(r, c) } else { [None; 8] };
+    let nb = if plane.valid[i] { view.neighbours(r, c) } else { [None; 8] };
     for (k, j) in nb.into_iter().enumerate() {
         let (mut d, mut ok) = ([0.0; 3], 0.0);
         if let Some(j) = j {
-            let dj = [soa.x[j] - soa.x[i], soa.y[j] - soa.y[i], soa.z[j] - soa.z[i]];
+            let dj = [plane.x[j] - plane.x[i], plane.y[j] - plane.y[i], plane.z[j] - plane.z[i]];
             if tests.keep(k, dj[0] * dj[0] + dj[1] * dj[1] + dj[2] * dj[2], ranges[j], ranges[i]) {
                 (d, ok) = (dj, 1.0);
             }
@@ -397,10 +466,10 @@ fn fill_one(
         (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l], lanes.ok[k][l]) = (d[0], d[1], d[2], ok);
         lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     }
-    soa.valid[i]
+    plane.valid[i]
 }
 
-/// Eq. 1-3 for `L` cells from their neighbour offsets: the unit normal `(nx, ny, nz)` and `n_rho`
+/// Eq. 1-3 for `L` cells from their neighbour offsets into `out`: the unit normal and `n_rho`
 /// per lane, zeros where a cell has too few pairs or a degenerate sum.
 ///
 /// Every lane does the operations of the per-cell definition in its order (sums over `k` from
@@ -410,7 +479,7 @@ fn fill_one(
 ///   (`|n_i|^2 > 1e-24 |d_i|^2 |d_(i-1)|^2`);
 /// - Eq. 2 weight `1 / (|d_i| + |d_(i-1)|)`, Eq. 3 term `(n . n_i) / |n_i|` averaged over pairs.
 #[inline(always)]
-fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
+fn lane_features(d: &Lanes, min_pairs: f32, out: &mut Cells) {
     let (dx, dy, dz, ok, len) = (&d.dx, &d.dy, &d.dz, &d.ok, &d.len);
     let mut acc = Acc::default();
     for k in 0..8 {
@@ -430,14 +499,34 @@ fn lane_features(d: &Lanes, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f
             acc.add(l, [x, y, z], iv, valid / (lk + lp).max(f32::MIN_POSITIVE), valid);
         }
     }
-    acc.finish(min_pairs)
+    acc.finish(min_pairs, out);
+}
+
+/// Features of `L` cells, lane-wise: the unit normal and `n_rho`.
+#[derive(Default)]
+struct Cells {
+    n: [[f32; L]; 3],
+    rho: [f32; L],
+}
+
+impl Cells {
+    /// Takes the lanes where `take` is set from `other`.
+    #[inline(always)]
+    fn take(&mut self, take: &[bool; L], other: &Cells) {
+        for l in 0..L {
+            for a in 0..3 {
+                self.n[a][l] = if take[l] { other.n[a][l] } else { self.n[a][l] };
+            }
+            self.rho[l] = if take[l] { other.rho[l] } else { self.rho[l] };
+        }
+    }
 }
 
 impl Acc {
-    /// Eq. 2-3 from the sums: the unit normal `(nx, ny, nz)` and `n_rho` per lane, zeros where a
+    /// Eq. 2-3 from the sums into `out`: the unit normal and `n_rho` per lane, zeros where a
     /// cell has fewer than `min_pairs` pairs or a degenerate sum.
     #[inline(always)]
-    fn finish(&self, min_pairs: f32) -> ([f32; L], [f32; L], [f32; L], [f32; L]) {
+    fn finish(&self, min_pairs: f32, out: &mut Cells) {
         let ([sx, sy, sz], [ex, ey, ez], pairs) = (&self.s, &self.e, &self.pairs);
         let (mut ux, mut uy, mut uz, mut good) = ([0f32; L], [0f32; L], [0f32; L], [false; L]);
         for l in 0..L {
@@ -448,12 +537,11 @@ impl Acc {
             (ux[l], uy[l], uz[l]) = (sx[l] * inv_len, sy[l] * inv_len, sz[l] * inv_len);
         }
         // Eq. 3: mean cosine similarity between n and its generating normals.
-        let (mut ox, mut oy, mut oz, mut rho) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+        let ([ox, oy, oz], rho) = (&mut out.n, &mut out.rho);
         for l in 0..L {
             let q = (ux[l] * ex[l] + uy[l] * ey[l] + uz[l] * ez[l]) / pairs[l];
             (ox[l], oy[l], oz[l], rho[l]) = if good[l] { (ux[l], uy[l], uz[l], q) } else { (0.0, 0.0, 0.0, 0.0) };
         }
-        (ox, oy, oz, rho)
     }
 }
 

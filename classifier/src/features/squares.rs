@@ -63,18 +63,28 @@ fn length(d: [f32; 3]) -> f32 {
     (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
 
-/// Chunks of a square row for `cols` columns.
-pub(super) fn chunks(cols: usize) -> usize {
-    cols.div_ceil(L)
+/// Square chunks whose 16 cells are clear of both grid edges (`j L + L < cols`): the fast path
+/// runs on chunks `1..` this (and reads the squares of chunk 0 through lane 0 of chunk 1).
+pub(super) fn inner_chunks(cols: usize) -> usize {
+    (cols - 1) / L
 }
 
-/// Fills `out` ([`chunks`] long) with the triangles and edge lengths of the squares between rows
-/// `s` and `s + 1` of the plane (`xs`, `ys`, `zs`: row-major, padded with at least `L + 1` values
-/// past the last row). Squares past column `cols - 2`, or with a corner without a return, get
-/// meaningless values; the fast path never reads them.
+/// Fills `out` (one per chunk of `chunks`) with the triangles and edge lengths of the squares
+/// between rows `s` and `s + 1` of the plane (the coordinates `x`, `y`, `z`, each row-major). `edge` holds the last
+/// square of the chunk before `chunks` (lane 0 of the first chunk) and gets the last square of
+/// `chunks`. Squares with a corner without a return get meaningless values; the fast path never
+/// reads them. Needs `chunks.end <= inner_chunks(cols)` and `s + 1` a row of the plane.
 #[inline(always)]
-pub(super) fn square_row(xs: &[f32], ys: &[f32], zs: &[f32], s: usize, cols: usize, out: &mut [SquareChunk]) {
-    for (j, o) in out[..chunks(cols)].iter_mut().enumerate() {
+pub(super) fn square_row(
+    [xs, ys, zs]: [&[f32]; 3],
+    s: usize,
+    cols: usize,
+    chunks: std::ops::Range<usize>,
+    edge: &mut [f32; SQUARE_FIELDS],
+    out: &mut [SquareChunk],
+) {
+    let out = &mut out[..chunks.len()];
+    for (o, j) in out.iter_mut().zip(chunks) {
         let (ia, iu) = (s * cols + j * L, (s + 1) * cols + j * L);
         let load = |i: usize| [at(xs, i), at(ys, i), at(zs, i)];
         let (a, b, u, v) = (load(ia), load(ia + 1), load(iu), load(iu + 1));
@@ -98,20 +108,29 @@ pub(super) fn square_row(xs: &[f32], ys: &[f32], zs: &[f32], s: usize, cols: usi
         }
     }
     // Lane 0: the previous chunk's last square.
-    for j in 1..chunks(cols) {
-        let (done, rest) = out.split_at_mut(j);
-        for (o, p) in rest[0].iter_mut().zip(&done[j - 1]) {
-            o[0] = p[L];
+    for (f, e) in edge.iter_mut().enumerate() {
+        let mut last = *e;
+        for o in out.iter_mut() {
+            o[f][0] = last;
+            last = o[f][L];
         }
+        *e = last;
     }
 }
 
-/// Fills `out[..cols - 1]` with the lengths of the horizontal edges `|P(r, c + 1) - P(r, c)|` of row `r`.
+/// Sets `out[c]` to the length of the horizontal edge `|P(r, c + 1) - P(r, c)|` of row `r` for the
+/// columns `c` of `range` (`range.end < cols`).
 #[inline(always)]
-pub(super) fn horizontal_row(xs: &[f32], ys: &[f32], zs: &[f32], r: usize, cols: usize, out: &mut [f32]) {
+pub(super) fn horizontal_row(
+    [xs, ys, zs]: [&[f32]; 3],
+    r: usize,
+    cols: usize,
+    range: std::ops::Range<usize>,
+    out: &mut [f32],
+) {
     let row = r * cols..(r + 1) * cols;
     let (x, y, z) = (&xs[row.clone()], &ys[row.clone()], &zs[row]);
-    for c in 0..cols - 1 {
+    for c in range {
         out[c] = length([x[c + 1] - x[c], y[c + 1] - y[c], z[c + 1] - z[c]]);
     }
 }
@@ -136,15 +155,16 @@ fn window(chunk: &SquareChunk, f: usize, back: usize) -> [f32; L] {
 }
 
 /// Accumulates Eq. 2 and the sum of unit pair normals for the `L` cells from `(r, c0)` on
-/// (`c0 = j L`, `j >= 1`), all with their 8 direct neighbours present, from the square rows
-/// `below` (`r - 1`) and `above` (`r`) and the horizontal edge lengths `horizontal` of row `r`.
+/// (`c0 = j L`, `1 <= j < inner_chunks(cols)`), all with their 8 direct neighbours present, from
+/// chunk `j` of the square rows `below` (`r - 1`) and `above` (`r`) and the horizontal edge lengths
+/// `horizontal` of row `r` (indexed by column).
 /// The same operations per pair as [`super::lane_features`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(super) fn dense_block(
     ranges: &[f32],
-    below: &[SquareChunk],
-    above: &[SquareChunk],
+    below: &SquareChunk,
+    above: &SquareChunk,
     horizontal: &[f32],
     r: usize,
     j: usize,
@@ -152,7 +172,6 @@ pub(super) fn dense_block(
     tests: &Tests,
 ) -> Acc {
     let c0 = j * L;
-    let (below, above) = (&below[j], &above[j]);
     // |d_k| for d1..d8, from the squares and row edges that hold them.
     let len = [
         window(above, VERTICAL, 0),
