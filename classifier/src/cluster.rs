@@ -182,6 +182,20 @@ pub struct ClusterWorkspace {
 
 const NONE: u32 = u32::MAX;
 
+/// 8 flags as the bytes of a word (flag `k` in byte `k`, 0 or 1).
+#[inline(always)]
+fn bytes8(flags: &[bool]) -> u64 {
+    flags[..8].iter().enumerate().fold(0, |w, (k, &f)| w | (u64::from(f) << (8 * k)))
+}
+
+/// The bytes (each 0 or 1) of `w` as the 8 low bits: byte `k` to bit `k`. The multiplication
+/// moves byte `k` to bit `56 + k` (each byte meets one power of two there, the other products
+/// fall below bit 56 or past bit 63, on distinct bits: no carries).
+#[inline(always)]
+fn pack8(w: u64) -> u64 {
+    w.wrapping_mul(0x0102_0408_1020_4080) >> 56
+}
+
 /// A count of [`ClusterWorkspace`]'s `near` squares not computed yet.
 const NOT_YET: u32 = u32::MAX;
 
@@ -290,18 +304,31 @@ pub fn cluster_candidates_with(
         }
     }
     ws.returns = ws.valid.iter().map(|&v| usize::from(v)).sum();
-    // Only cells with a return can be candidates. The member list (candidates in increasing
-    // order) is appended without a branch per cell: the passes below visit only the members.
+    // Only cells with a return can be candidates: the members, each its own root to begin with.
+    ws.parent.clear();
     ws.parent.resize(n, NONE);
-    ws.members.resize(n, 0);
-    let mut members = 0;
-    for (i, ((p, &c), &v)) in ws.parent.iter_mut().zip(&candidate[..n]).zip(&ws.valid[..n]).enumerate() {
-        let member = c & v;
-        *p = if member { i as u32 } else { NONE };
-        ws.members[members] = i as u32;
-        members += usize::from(member);
+    // The member list (in increasing order): the passes below visit only the members. Per 64
+    // cells a bit mask (8 cells per multiplication, [`pack8`]), whose set bits are then listed:
+    // a step per member, none per cell.
+    ws.members.clear();
+    for (k, (cand, valid)) in candidate[..n].chunks(64).zip(ws.valid[..n].chunks(64)).enumerate() {
+        let mut mask = 0u64;
+        if cand.len() == 64 {
+            for (b, (c, v)) in cand.chunks_exact(8).zip(valid.chunks_exact(8)).enumerate() {
+                mask |= pack8(bytes8(c) & bytes8(v)) << (8 * b);
+            }
+        } else {
+            for (b, (&c, &v)) in cand.iter().zip(valid).enumerate() {
+                mask |= u64::from(c & v) << b;
+            }
+        }
+        while mask != 0 {
+            let i = (k * 64) as u32 + mask.trailing_zeros();
+            ws.members.push(i);
+            ws.parent[i as usize] = i;
+            mask &= mask - 1;
+        }
     }
-    ws.members.truncate(members);
     // Per column of the current row: returns in the rows below, at and above.
     ws.column_valid.clear();
     ws.column_valid.resize(cols, false);
@@ -654,6 +681,14 @@ mod tests {
 
     fn frame(drop: f32, seed: u64, spinning: bool) -> sim::OrderedCloud {
         crate::synthetic::noisy_cars_frame(drop, seed, spinning, 0.05)
+    }
+
+    #[test]
+    fn pack8_moves_byte_k_to_bit_k() {
+        for bits in 0..=255u64 {
+            let flags: Vec<bool> = (0..8).map(|k| bits >> k & 1 == 1).collect();
+            assert_eq!(pack8(bytes8(&flags)), bits);
+        }
     }
 
     #[test]
