@@ -533,7 +533,13 @@ impl ClusterWorkspace {
         self.near.clear();
         self.near.resize(wx * (ny + 2), (0.0, NOT_YET));
         // Consecutive members mostly share a root: its sums stay in registers for the run.
-        let (mut run, mut inside, mut height, mut outside) = (NONE, 0u32, 0f32, Vec3::ZERO);
+        // A cluster whose box lies beyond the area's border has all its points outside: those
+        // only add up (most of the terrain beside a road on `rural`).
+        let beyond = |(lo, hi): (glam::Vec2, glam::Vec2)| {
+            let ((x0, y0), (x1, y1)) = (square(lo.extend(0.0)), square(hi.extend(0.0)));
+            x1 < -1 || y1 < -1 || x0 > nx as isize || y0 > ny as isize
+        };
+        let (mut run, mut far, mut inside, mut height, mut outside) = (NONE, false, 0u32, 0f32, Vec3::ZERO);
         for &i in &self.members {
             let root = self.parent[i as usize];
             if root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points {
@@ -547,8 +553,13 @@ impl ClusterWorkspace {
                 run = root;
                 let r = root as usize;
                 (inside, height, outside) = (self.inside[r], self.height_sum[r], self.outside_sum[r]);
+                far = beyond(self.bbox[r]);
             }
             let p = points[i as usize];
+            if far {
+                outside += p;
+                continue;
+            }
             let (x, y) = square(p);
             // Squares beyond the border have no area square around them.
             let (mean, cnt) = if (-1..=nx as isize).contains(&x) && (-1..=ny as isize).contains(&y) {
