@@ -495,26 +495,27 @@ impl ClusterWorkspace {
         };
         // Consecutive points mostly fall in one square: its sums stay in registers for the run
         // (the same additions in the same order, without a chain through memory per point).
+        let (parent, area) = (&self.parent[..], &mut self.area[..]);
         let (mut run, mut acc) = (usize::MAX, (0f32, 0u32));
         for &i in &self.members {
-            if self.parent[i as usize] == largest as u32 {
+            if parent[i as usize] == largest as u32 {
                 let p = points[i as usize];
                 // The largest cluster's points lie inside its box: `p - lo >= 0`, whose truncation
-                // is its floor (one conversion, no correction).
-                let x = (((p.x - lo.x) * per_cell) as usize).min(nx - 1);
-                let y = (((p.y - lo.y) * per_cell) as usize).min(ny - 1);
+                // is its floor (one conversion, no correction; `nx`, `ny` <= 4096).
+                let x = (((p.x - lo.x) * per_cell) as i32).clamp(0, nx as i32 - 1) as usize;
+                let y = (((p.y - lo.y) * per_cell) as i32).clamp(0, ny as i32 - 1) as usize;
                 let k = y * nx + x;
                 if k != run {
                     if run != usize::MAX {
-                        self.area[run] = acc;
+                        area[run] = acc;
                     }
-                    (run, acc) = (k, self.area[k]);
+                    (run, acc) = (k, area[k]);
                 }
                 acc = (acc.0 + p.z, acc.1 + 1);
             }
         }
         if run != usize::MAX {
-            self.area[run] = acc;
+            area[run] = acc;
         }
         // Area test per cluster: count inside points and their height above the local ground.
         // Per-root arrays: sized once, reset at the roots only (they are read nowhere else).
