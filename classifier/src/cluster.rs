@@ -285,11 +285,8 @@ pub fn cluster_candidates_with(
     ws: &mut ClusterWorkspace,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("bmi1")
-        && std::arch::is_x86_feature_detected!("bmi2")
-    {
-        // SAFETY: the CPU supports AVX2 and BMI1 (checked just above).
+    if avx2_bmi() {
+        // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
         #[allow(unsafe_code)]
         unsafe {
             return cluster_avx2(view, valid, candidate, normal, params, ws);
@@ -298,7 +295,15 @@ pub fn cluster_candidates_with(
     cluster_body(view, valid, candidate, normal, params, ws);
 }
 
-/// [`cluster_body`] compiled for AVX2 and BMI1.
+/// Whether the CPU runs the code compiled for AVX2, BMI1 and BMI2.
+#[cfg(target_arch = "x86_64")]
+fn avx2_bmi() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+}
+
+/// [`cluster_body`] compiled for AVX2, BMI1 and BMI2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,bmi2")]
 fn cluster_avx2(
@@ -516,11 +521,8 @@ impl ClusterWorkspace {
     /// [`cluster_candidates_with`].)
     pub fn decide(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("bmi1")
-            && std::arch::is_x86_feature_detected!("bmi2")
-        {
-            // SAFETY: the CPU supports AVX2 and BMI1 (checked just above).
+        if avx2_bmi() {
+            // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
             #[allow(unsafe_code)]
             unsafe {
                 return self.decide_avx2(points, returns, params, ground);
@@ -529,7 +531,7 @@ impl ClusterWorkspace {
         self.decide_body(points, returns, params, ground);
     }
 
-    /// [`ClusterWorkspace::decide_body`] compiled for AVX2 and BMI1.
+    /// [`ClusterWorkspace::decide_body`] compiled for AVX2, BMI1 and BMI2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2")]
     fn decide_avx2(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {

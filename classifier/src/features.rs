@@ -345,13 +345,14 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
     // The fast path needs a row on either side and blocks clear of both edges.
     let inner = if rows >= 3 && cols > L { squares::inner_chunks(cols) } else { 0 };
-    let general = |r: usize| if r == 0 || r + 1 == rows || inner < 2 { 0..0 } else { 1..inner };
+    // The chunks of row `r` that the fast path below takes; every other block here.
+    let fast_chunks = |r: usize| if r == 0 || r + 1 == rows || inner < 2 { 0..0 } else { 1..inner };
     for r in 0..rows {
-        let skip = general(r);
+        let fast = fast_chunks(r);
         let mut c0 = 0;
         while c0 < cols {
-            if skip.contains(&(c0 / L)) {
-                c0 = skip.end * L;
+            if fast.contains(&(c0 / L)) {
+                c0 = fast.end * L;
                 continue;
             }
             let m = (cols - c0).min(L);
