@@ -723,6 +723,37 @@ mod tests {
     }
 
     #[test]
+    fn small_and_odd_grids_equal_the_per_cell_definition() {
+        // Corners of the spinning frame cut to sizes around the fast path's limits (3 rows, a
+        // chunk clear of both edges, tiles of 8 chunks), wrapping and not.
+        let cloud = frame(0.1, 5, true);
+        let (mut cells, mut featured) = (0, 0);
+        for (rows, cols) in [(1, 1), (1, 40), (2, 33), (3, 17), (3, 18), (3, 33), (4, 47), (5, 150), (7, 161)] {
+            let (mut points, mut ranges) = (Vec::new(), Vec::new());
+            for r in 0..rows {
+                let row = (r + 10) * cloud.cols;
+                points.extend_from_slice(&cloud.point_in_vehicle[row..row + cols]);
+                ranges.extend_from_slice(&cloud.range_m[row..row + cols]);
+            }
+            for wrap in [false, true] {
+                let view = GridView { points: &points, ranges: &ranges, rows, cols, wrap, max_col_gap: 2 };
+                let params = FeatureParams::default();
+                let mut got = Features::default();
+                compute_features(&view, &params, &mut got);
+                for (i, &(n, n_rho, g_rho)) in reference(&view, &params).iter().enumerate() {
+                    assert!((got.normal[i] - n).abs().max_element() <= 1e-5, "{rows} x {cols}, cell {i}");
+                    assert!((got.n_rho[i] - n_rho).abs() <= 1e-5, "{rows} x {cols}, cell {i}");
+                    assert!((got.g_rho[i] - g_rho).abs() <= 1e-5, "{rows} x {cols}, cell {i}");
+                    featured += usize::from(n_rho > 0.5);
+                }
+                cells += rows * cols;
+            }
+        }
+        // Most of the cut cells have features: the comparison is not between zeros.
+        assert!(featured * 2 > cells, "{featured} of {cells}");
+    }
+
+    #[test]
     fn lane_wise_features_equal_the_per_cell_definition() {
         /// Largest difference allowed in a feature (all lie in [-1, 1]).
         const TOL: f32 = 1e-5;
