@@ -2,8 +2,8 @@
 //! (target: at most 5 ms in release), and the stages separately. Pin it to one core:
 //! `taskset -c 0 cargo bench -p classifier`.
 
-use classifier::cluster::{ClusterWorkspace, cluster_candidates};
-use classifier::features::{Features, compute_features};
+use classifier::nitsch::cluster::{ClusterWorkspace, cluster_candidates};
+use classifier::nitsch::features::{Features, compute_features};
 use classifier::synthetic::benchmark_frame;
 use classifier::{Nitsch, NitschParams};
 use criterion::{Criterion, criterion_group, criterion_main};

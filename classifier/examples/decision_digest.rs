@@ -3,7 +3,7 @@
 //! before and after a performance change: identical lines mean identical outputs.
 //! `cargo run --release -p classifier --example decision_digest`
 
-use classifier::neighbours::Wrap;
+use classifier::nitsch::neighbours::Wrap;
 use classifier::synthetic::{SyntheticSensor, benchmark_frame, car, flat_ground};
 use classifier::{Nitsch, NitschParams};
 use glam::Vec3;

@@ -2,8 +2,8 @@
 //! *3D Ground Point Classification for Automotive Scenarios*, with the baselines of its Table I
 //! and the metrics to compare them.
 //!
-//! Data flow: an [`sim::OrderedCloud`] -> [`neighbours`] (the 8-neighbourhood of Fig. 3 on the grid)
-//! -> [`features`] (`n`, `n_rho`, `g_rho`, Eq. 1-4) -> [`cluster`] (conditional Euclidean clustering
+//! Data flow: an [`sim::OrderedCloud`] -> [`nitsch::neighbours`] (the 8-neighbourhood of Fig. 3 on the grid)
+//! -> [`nitsch::features`] (`n`, `n_rho`, `g_rho`, Eq. 1-4) -> [`nitsch::cluster`] (conditional Euclidean clustering
 //! and the cluster rules of Sec. III-B) -> a ground decision per cell ([`nitsch`]). The baselines
 //! ([`baselines::ransac`], [`baselines::grid`]) and the method live behind one trait in
 //! [`methods`], chosen by name from [`METHODS`]. [`metrics`] scores decisions against ground truth;
@@ -14,12 +14,9 @@
 //! cells without a return are never ground.
 
 pub mod baselines;
-pub mod cluster;
 pub mod error;
-pub mod features;
 pub mod methods;
 pub mod metrics;
-pub mod neighbours;
 pub mod nitsch;
 pub mod ordering;
 pub mod synthetic;

@@ -1,7 +1,7 @@
 //! Classification tests on analytic scenes: car roofs, a basin, clustering against brute force,
 //! echo planes, bad input, the method registry and the grid accumulation baseline.
 
-use classifier::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates};
+use classifier::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates};
 use classifier::synthetic::{Shape, SyntheticSensor, car, flat_ground};
 use classifier::{ClassifyError, Evaluation, FrameInput, METHODS, Nitsch, NitschParams, method_by_name};
 use glam::{Affine3A, Vec3};
@@ -241,7 +241,7 @@ fn cluster_and_decide(pts: &[Vec3], cols: usize, params: &ClusterParams) -> (usi
     let rows = pts.len() / cols;
     let ranges: Vec<f32> = pts.iter().map(|p| p.length()).collect();
     let view =
-        classifier::neighbours::GridView { points: pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
+        classifier::nitsch::neighbours::GridView { points: pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
     let candidate: Vec<bool> = pts.iter().map(|p| p.is_finite()).collect();
     let normals = vec![Vec3::Z; pts.len()];
     let returns = candidate.iter().filter(|&&c| c).count();

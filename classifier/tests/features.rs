@@ -1,7 +1,7 @@
 //! Feature tests on analytic synthetic clouds: flat ground, walls, missing neighbours, wrap-around.
 
-use classifier::features::{FeatureParams, Features, compute_features};
-use classifier::neighbours::{GridView, MAX_ROW_GAP, detect_wrap};
+use classifier::nitsch::features::{FeatureParams, Features, compute_features};
+use classifier::nitsch::neighbours::{GridView, MAX_ROW_GAP, detect_wrap};
 use classifier::synthetic::{Shape, SyntheticSensor, flat_ground};
 use glam::Vec3;
 use sim::{OrderedCloud, SemanticClass};

@@ -11,7 +11,7 @@
 //! (15 cm) of the patch's elevation. Frames are accumulated in the order they are classified, the
 //! current frame included, using `world_from_vehicle`; without a pose the map is reset every frame
 //! (the frame is its own map). With clustering, the points the grid calls ground are the candidates
-//! of the clustering and cluster rules of [`crate::cluster`] (plane 0; other planes as in
+//! of the clustering and cluster rules of [`crate::nitsch::cluster`] (plane 0; other planes as in
 //! [`crate::nitsch`]); without, every return is tested against the map directly.
 
 use std::collections::HashMap;
@@ -106,7 +106,7 @@ impl GridAccumulation {
             return Err(ClassifyError::invalid("world_from_vehicle", "non-finite", "a finite rigid transform"));
         }
         let view = self.nitsch.view(cloud);
-        crate::features::compute_features(&view, &self.nitsch.params.features, &mut self.nitsch.features);
+        crate::nitsch::features::compute_features(&view, &self.nitsch.params.features, &mut self.nitsch.features);
         self.world.clear();
         self.world.extend(cloud.point_in_vehicle.iter().map(|&p| pose.transform_point3(p)));
         let n0 = cloud.rows * cloud.cols;
@@ -130,7 +130,7 @@ impl GridAccumulation {
         if self.params.cluster {
             let candidate = out[..n0].to_vec();
             let ws = &mut ClusterState::default();
-            crate::cluster::cluster_candidates(
+            crate::nitsch::cluster::cluster_candidates(
                 &view,
                 &candidate,
                 &self.nitsch.features.normal,
@@ -148,4 +148,4 @@ impl GridAccumulation {
 }
 
 #[derive(Default)]
-struct ClusterState(crate::cluster::ClusterWorkspace);
+struct ClusterState(crate::nitsch::cluster::ClusterWorkspace);

@@ -7,12 +7,16 @@
 //! cells around it if that return is within `echo_match_m`, and is not ground otherwise (a second
 //! echo from the ground behind a thin object lies next to plane-0 ground; one behind a bush does not).
 
+pub mod cluster;
+pub mod features;
+pub mod neighbours;
+
 use glam::Vec3;
 
-use crate::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_with};
+use crate::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_with};
 use crate::error::{ClassifyError, Result, check_cloud, is_valid};
-use crate::features::{FeatureParams, Features, compute_features};
-use crate::neighbours::{GridView, NeighbourParams, Wrap, detect_wrap};
+use crate::nitsch::features::{FeatureParams, Features, compute_features};
+use crate::nitsch::neighbours::{GridView, NeighbourParams, Wrap, detect_wrap};
 
 /// All parameters of the method.
 #[derive(Clone, Copy, Debug, PartialEq)]

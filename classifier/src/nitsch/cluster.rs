@@ -3,7 +3,7 @@
 //!
 //! Clustering (decision): PCL's conditional Euclidean clustering joins two points when they are
 //! within a radius and a condition holds. Here the radius search uses the grid's own adjacency
-//! (the 8-neighbourhood of [`crate::neighbours`]) instead of a k-d tree: two candidates join when
+//! (the 8-neighbourhood of [`crate::nitsch::neighbours`]) instead of a k-d tree: two candidates join when
 //! they are grid neighbours and their distance is at most `link_tolerance_m + link_tolerance_rel *
 //! max(|p_a|, |p_b|)` (distances from the vehicle origin). The range-proportional part defaults to
 //! 0 (a fixed 0.5 m radius, as PCL uses): the tangent-plane link below already joins far rings,
@@ -64,7 +64,7 @@
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
-use crate::neighbours::GridView;
+use crate::nitsch::neighbours::GridView;
 
 /// Parameters of clustering and of the cluster rules.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -271,7 +271,7 @@ pub fn cluster_candidates(
 }
 
 /// [`cluster_candidates`] with the cells that hold a return given (`valid`, as
-/// [`crate::features::Features::valid`] has them) rather than found again from the points.
+/// [`crate::nitsch::features::Features::valid`] has them) rather than found again from the points.
 ///
 /// Runs as code compiled for AVX2 and BMI where the CPU has them (measured: 5-8 % faster than the
 /// baseline x86-64 build); the results are the same, as every float operation is a plain IEEE one

@@ -4,7 +4,7 @@
 //!
 //! Decisions where the paper is silent (tested below):
 //! - A pair normal `n_i = d_i x d_(i-1)` exists only where both neighbours exist (see
-//!   [`crate::neighbours`] for what counts as a neighbour) and the cross product is not degenerate.
+//!   [`crate::nitsch::neighbours`] for what counts as a neighbour) and the cross product is not degenerate.
 //! - `n_rho` averages the cosine similarity over the pairs that exist rather than always dividing by
 //!   8 (identical when all 8 neighbours exist); otherwise the lowest ring, which always lacks the
 //!   three neighbours below it, could never exceed `n_rho = 0.5` and never be ground.
@@ -41,7 +41,7 @@ mod squares;
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
-use crate::neighbours::GridView;
+use crate::nitsch::neighbours::GridView;
 
 /// Parameters of the feature computation besides the neighbourhood.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,7 +141,7 @@ impl Features {
 /// so it vectorizes across cells (16: one AVX-512 register, two AVX2 registers).
 const L: usize = 16;
 
-/// Grid offsets `(row, col)` of `d1..d8` (see [`crate::neighbours`]).
+/// Grid offsets `(row, col)` of `d1..d8` (see [`crate::nitsch::neighbours`]).
 const OFFSETS: [(isize, isize); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
 
 /// Neighbour offsets of `L` cells, lane-wise: `dx[k][l]` is `d_(k+1)` of lane `l` (0 where missing in
@@ -617,7 +617,7 @@ mod tests {
 
     use super::*;
     use crate::error::is_valid;
-    use crate::neighbours::detect_wrap;
+    use crate::nitsch::neighbours::detect_wrap;
 
     /// The per-cell definition: neighbours by [`GridView::neighbours`], then Eq. 1-3.
     fn reference(view: &GridView<'_>, params: &FeatureParams) -> Vec<(Vec3, f32, f32)> {
