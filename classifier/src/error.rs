@@ -42,6 +42,17 @@ pub enum ClassifyError {
         /// What is missing.
         what: &'static str,
     },
+    /// A training (or ROC) set without ground or without non-ground points.
+    #[error("training set has {ground} ground and {non_ground} non-ground candidates: both classes are needed")]
+    TrainingSet {
+        /// Ground (positive) points.
+        ground: usize,
+        /// Non-ground (negative) points.
+        non_ground: usize,
+    },
+    /// A model file (or model) that cannot be used.
+    #[error(transparent)]
+    Model(#[from] crate::mcdaniel::ModelError),
     /// A beam table or unordered cloud that ordering recovery cannot use.
     #[error("ordering recovery: {0}")]
     Ordering(String),

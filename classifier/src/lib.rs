@@ -8,20 +8,24 @@
 //! ([`baselines::ransac`], [`baselines::grid`]) and the method live behind one trait in
 //! [`methods`], chosen by name from [`METHODS`]. [`metrics`] scores decisions against ground truth;
 //! [`ordering`] turns unordered clouds (KITTI `.bin`) into grids; [`synthetic`] builds analytic test
-//! clouds.
+//! clouds. [`mcdaniel`] is the forest method of McDaniel et al. (min-z columns, eight features, a
+//! linear SVM); [`sensor_origin`] estimates sensor origins from a cloud's (point, range) pairs.
 //!
 //! Decisions are one `bool` per cell of the cloud, in the cloud's grid order over all echo planes;
 //! cells without a return are never ground.
 
 pub mod baselines;
 pub mod error;
+pub mod mcdaniel;
 pub mod methods;
 pub mod metrics;
 pub mod nitsch;
 pub mod ordering;
+pub mod sensor_origin;
 pub mod synthetic;
 
 pub use error::{ClassifyError, Result};
-pub use methods::{FrameInput, GroundClassifier, METHODS, method_by_name};
+pub use mcdaniel::{McDaniel, McDanielModel, McDanielParams};
+pub use methods::{FrameInput, GroundClassifier, METHODS, mcdaniel_with_model, method_by_name};
 pub use metrics::{Confusion, Evaluation, Scores};
 pub use nitsch::{Nitsch, NitschParams};

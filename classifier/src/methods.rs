@@ -5,11 +5,20 @@ use glam::Affine3A;
 use crate::baselines::grid::{GridAccumulation, GridParams};
 use crate::baselines::ransac::{self, RansacParams};
 use crate::error::{ClassifyError, Result};
+use crate::mcdaniel::{McDaniel, McDanielModel, McDanielParams};
 use crate::nitsch::{Nitsch, NitschParams, StageTimes};
 
 /// Every method name, as the command line takes them.
-pub const METHODS: &[&str] =
-    &["nitsch", "nitsch-0.7", "nitsch-no-cluster", "nitsch-no-cluster-0.7", "ransac", "grid", "grid-no-cluster"];
+pub const METHODS: &[&str] = &[
+    "nitsch",
+    "nitsch-0.7",
+    "nitsch-no-cluster",
+    "nitsch-no-cluster-0.7",
+    "ransac",
+    "grid",
+    "grid-no-cluster",
+    "mcdaniel",
+];
 
 /// One frame to classify.
 #[derive(Clone, Copy, Debug)]
@@ -33,6 +42,12 @@ pub trait GroundClassifier {
     /// Stage times of the last frame, where the method measures them.
     fn stage_times(&self) -> Option<StageTimes> {
         None
+    }
+    /// Stage times of the last frame as `(stage, seconds)` pairs in pipeline order, for any method
+    /// that measures them (Nitsch: `features`, `clustering`; McDaniel: `origins`, `stage1`, `f1-f6`,
+    /// `f7`, `f8`, `svm`, `propagate`); empty where none are measured.
+    fn named_stage_times(&self) -> Vec<(&'static str, f64)> {
+        self.stage_times().map_or_else(Vec::new, |t| vec![("features", t.features_s), ("clustering", t.clustering_s)])
     }
 }
 
@@ -72,7 +87,28 @@ impl GroundClassifier for GridMethod {
     }
 }
 
-/// Builds the method called `name` with its default parameters; `seed` seeds RANSAC.
+struct McDanielMethod(McDaniel);
+
+impl GroundClassifier for McDanielMethod {
+    fn name(&self) -> &'static str {
+        "mcdaniel"
+    }
+    fn classify(&mut self, frame: &FrameInput<'_>) -> Result<Vec<bool>> {
+        self.0.classify(frame.cloud)
+    }
+    fn named_stage_times(&self) -> Vec<(&'static str, f64)> {
+        self.0.times.named()
+    }
+}
+
+/// The `mcdaniel` method with a given model (e.g. loaded from `--model FILE` with
+/// [`McDanielModel::load`]) and parameters.
+pub fn mcdaniel_with_model(model: McDanielModel, params: McDanielParams) -> Result<Box<dyn GroundClassifier + Send>> {
+    Ok(Box::new(McDanielMethod(McDaniel::new(model, params)?)))
+}
+
+/// Builds the method called `name` with its default parameters; `seed` seeds RANSAC. `mcdaniel`
+/// uses the bundled model trained on the forests ([`crate::mcdaniel::default_model`]).
 pub fn method_by_name(name: &str, seed: u64) -> Result<Box<dyn GroundClassifier + Send>> {
     let nitsch = |threshold: f32, cluster: bool| NitschParams { threshold, cluster, ..Default::default() };
     Ok(match name {
@@ -86,6 +122,7 @@ pub fn method_by_name(name: &str, seed: u64) -> Result<Box<dyn GroundClassifier 
             "grid-no-cluster",
             GridAccumulation::new(GridParams { cluster: false, ..Default::default() })?,
         )),
+        "mcdaniel" => mcdaniel_with_model(crate::mcdaniel::default_model()?, McDanielParams::default())?,
         _ => return Err(ClassifyError::UnknownMethod { name: name.to_string(), known: METHODS.join(", ") }),
     })
 }
