@@ -2,6 +2,12 @@
 //! thread, printing one JSON object: frames, grid size, and mean / min milliseconds per frame for
 //! features, clustering (candidates, clustering and cluster rules) and the whole classification.
 //! Methods that do not report stages (ransac, grid) give only the total.
+//!
+//! With `--input FILE|DIR` it times the whole path on files instead (`.pcd` and `.bin`, a directory's
+//! files in name order): read, order (unfolding or the beam table of `--rig`, as `classify` does)
+//! and classify, each file `--repeats` times, and prints per file the grid, the ordering path and
+//! its counts, and mean / min milliseconds of `read_ms`, `order_ms`, `classify_ms` and `total_ms`,
+//! plus the same over all files. Run it under `taskset -c 0` for one core.
 
 use std::time::Instant;
 
@@ -18,7 +24,8 @@ pub struct Args {
     /// Scene name or TOML file.
     #[arg(long, default_value = "city")]
     scene: String,
-    /// Rig name or TOML file.
+    /// Rig name or TOML file (with `--input`: the beam table for `.bin` files; left at its default,
+    /// `.bin` files use the HDL-64E nominal table as `classify` does without `--rig`).
     #[arg(long, default_value = "os1-128-roof")]
     rig: String,
     /// Frames to scan.
@@ -30,10 +37,109 @@ pub struct Args {
     /// Seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Time real files instead of a scan: a `.pcd` / `.bin` file or a directory of them.
+    #[arg(long)]
+    input: Option<std::path::PathBuf>,
+}
+
+fn stats(v: &[f64]) -> serde_json::Value {
+    if v.is_empty() {
+        serde_json::Value::Null
+    } else {
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let min = v.iter().copied().fold(f64::INFINITY, f64::min);
+        serde_json::json!({ "mean": mean, "min": min })
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Times read + order + classify on files.
+fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
+    let files: Vec<std::path::PathBuf> = if input.is_dir() {
+        let mut v: Vec<_> = std::fs::read_dir(input)
+            .with_context(|| format!("reading directory `{}`", input.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("pcd" | "bin")))
+            .collect();
+        v.sort();
+        v
+    } else {
+        vec![input.to_path_buf()]
+    };
+    if files.is_empty() {
+        anyhow::bail!("no .pcd or .bin files in `{}`", input.display());
+    }
+    let rig = if args.rig == "os1-128-roof" && files.iter().any(|f| f.extension().is_some_and(|e| e == "bin")) {
+        None
+    } else {
+        Some(args.rig.as_str())
+    };
+    let repeats = args.repeats.max(1);
+    let mut method = method_by_name(&args.method, args.seed)?;
+    let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut per_file = Vec::new();
+    for (index, path) in files.iter().enumerate() {
+        let (mut read, mut order, mut cls, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut last = None;
+        for _ in 0..repeats {
+            let t0 = Instant::now();
+            let (frame, read_ms) = super::classify::read_frame_timed(path, rig)?;
+            let t2 = Instant::now();
+            let out = method.classify(&FrameInput { index, cloud: &frame.cloud, world_from_vehicle: None })?;
+            let bytes = match &frame.report {
+                Some(r) => classifier::ordering::decisions_per_point(r, &out),
+                None => out.iter().map(|&g| u8::from(g)).collect(),
+            };
+            cls.push(ms(t2));
+            total.push(ms(t0));
+            read.push(read_ms);
+            order.push((t2 - t0).as_secs_f64() * 1e3 - read_ms);
+            last = Some((frame, bytes.iter().filter(|&&b| b == 1).count(), bytes.len()));
+        }
+        let (frame, ground, points) = last.expect("one repeat");
+        per_file.push(serde_json::json!({
+            "file": path.display().to_string(),
+            "points": points,
+            "ground": ground,
+            "rows": frame.cloud.rows,
+            "cols": frame.cloud.cols,
+            "planes": frame.cloud.planes,
+            "ordering": frame.report.as_ref().map(|r| serde_json::to_value(r).unwrap_or_default()),
+            "read_ms": stats(&read),
+            "order_ms": stats(&order),
+            "classify_ms": stats(&cls),
+            "total_ms": stats(&total),
+        }));
+        all_read.extend(read);
+        all_order.extend(order);
+        all_cls.extend(cls);
+        all_total.extend(total);
+    }
+    let out = serde_json::json!({
+        "method": args.method,
+        "input": input.display().to_string(),
+        "rig": rig,
+        "files": per_file.len(),
+        "repeats": repeats,
+        "threads": 1,
+        "read_ms": stats(&all_read),
+        "order_ms": stats(&all_order),
+        "classify_ms": stats(&all_cls),
+        "total_ms": stats(&all_total),
+        "per_file": per_file,
+    });
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    Ok(())
 }
 
 /// Runs the classification benchmark and prints one JSON object.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(input) = &args.input {
+        return run_files(&args, input);
+    }
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;
     let config =
@@ -55,15 +161,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
         }
     }
-    let stats = |v: &[f64]| {
-        if v.is_empty() {
-            serde_json::Value::Null
-        } else {
-            let mean = v.iter().sum::<f64>() / v.len() as f64;
-            let min = v.iter().copied().fold(f64::INFINITY, f64::min);
-            serde_json::json!({ "mean": mean, "min": min })
-        }
-    };
     let first = &frames[0].cloud;
     let out = serde_json::json!({
         "method": args.method,

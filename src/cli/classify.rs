@@ -5,9 +5,12 @@
 //! Output per frame, in `--out`: `frame_NNNNNN.ground`, one byte per point in the input's point
 //! order, 1 = ground, 0 = not. For an organized PCD that is every cell of the grid in grid order
 //! (all echo planes), no-return cells included (always 0). For a KITTI `.bin` it is every point of
-//! the file in file order; the points are first put into ring x column order ([`classifier::ordering`])
-//! from the beam table of `--rig` (a single-sensor rig; default: the HDL-64E table with 2083
-//! columns), and points that ordering drops (a second point in a taken cell) are 0.
+//! the file in file order; the points are first put into ring x column order ([`classifier::ordering`]):
+//! by scan unfolding where the file is in scan order (as KITTI's and ours are), else from the beam
+//! table of `--rig` (a single-sensor rig, with its origin offsets; default: the HDL-64E nominal
+//! table with 2083 columns). Every point gets a cell (a shared cell keeps its second point on a
+//! further plane); only points with NaN or infinite coordinates are skipped (0, counted in the
+//! output; a file with more than 1 % of them is refused). The path taken and the counts are printed.
 //! Where the input has labels (PCD label field, KITTI `.label` beside the `.bin`), also
 //! `frame_NNNNNN.png`: a bird's-eye view coloured by outcome (true ground, false ground, missed
 //! ground, true non-ground).
@@ -17,7 +20,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use classifier::ordering::{BeamTable, order_points};
+use classifier::ordering::{
+    BeamTable, OrderingReport, PathChoice, PointAttributes, UnfoldParams, decisions_per_point, order_cloud,
+};
 use classifier::{FrameInput, method_by_name};
 use glam::{Affine3A, Mat4};
 use sim::OrderedCloud;
@@ -91,56 +96,59 @@ fn list_inputs(input: &Path) -> anyhow::Result<Vec<InputFrame>> {
         .collect())
 }
 
-/// The beam table of a single-sensor rig, with its mount.
-fn rig_table(name: &str) -> anyhow::Result<(BeamTable, Affine3A)> {
+/// The beam table of a single-sensor rig (elevations, columns and origin offsets), with its mount.
+pub(crate) fn rig_table(name: &str) -> anyhow::Result<(BeamTable, Affine3A)> {
     let rig = super::common::load_rig(name)?;
     if rig.sensors.len() != 1 {
         bail!("rig `{name}` has {} sensors; ordering a KITTI file needs a single-sensor rig", rig.sensors.len());
     }
     let s = &rig.sensors[0];
-    let pattern = s.spec.pattern();
-    let az = &pattern.col_azimuth_rad;
-    if az.len() < 2 {
-        bail!("rig `{name}`: the sensor has fewer than 2 columns");
-    }
-    let step = (az[0] - az[az.len() - 1]) / (az.len() - 1) as f32;
-    let full_turn = (step * az.len() as f32 - std::f32::consts::TAU).abs() < 1.5 * step;
-    let table = BeamTable {
-        elevations_rad: pattern.row_elevation_rad.clone(),
-        cols: pattern.cols,
-        azimuth_left_rad: az[0],
-        azimuth_step_rad: step,
-        full_turn,
-    };
+    let table = BeamTable::from_pattern(&s.spec.pattern()).with_context(|| format!("rig `{name}`"))?;
     // KITTI files of a single-sensor rig hold sensor-frame points.
     Ok((table, s.mount.vehicle_from_sensor()))
 }
 
-/// Reads a frame: the cloud to classify and, for KITTI, the cell of each input point.
-fn read_frame(path: &Path, rig: Option<&str>) -> anyhow::Result<(OrderedCloud, Option<Vec<Option<u32>>>)> {
+/// A frame read and ordered: the cloud to classify and, for unordered input, what ordering did.
+pub(crate) struct ReadFrame {
+    /// The cloud to classify.
+    pub cloud: OrderedCloud,
+    /// For KITTI input: the ordering report (cell of every input point).
+    pub report: Option<OrderingReport>,
+}
+
+/// Reads a frame: the cloud to classify and, for KITTI, the ordering report.
+pub(crate) fn read_frame(path: &Path, rig: Option<&str>) -> anyhow::Result<ReadFrame> {
+    Ok(read_frame_timed(path, rig)?.0)
+}
+
+/// As [`read_frame`], also returning the milliseconds spent reading the file (the rest is ordering).
+pub(crate) fn read_frame_timed(path: &Path, rig: Option<&str>) -> anyhow::Result<(ReadFrame, f64)> {
+    let t0 = std::time::Instant::now();
     match path.extension().and_then(|e| e.to_str()) {
-        Some("pcd") => Ok((sim::io::pcd::read(path)?, None)),
+        Some("pcd") => {
+            let cloud = sim::io::pcd::read(path)?;
+            Ok((ReadFrame { cloud, report: None }, t0.elapsed().as_secs_f64() * 1e3))
+        }
         Some("bin") => {
             let label = path.with_extension("label");
             let flat = sim::io::kitti::read(path, label.is_file().then_some(label.as_path()))?;
+            let read_ms = t0.elapsed().as_secs_f64() * 1e3;
             let (table, vehicle_from_sensor) = match rig {
                 Some(r) => rig_table(r)?,
                 None => (BeamTable::hdl64e(2083), Affine3A::IDENTITY),
             };
             let labels = label.is_file().then_some(flat.label.as_slice());
-            let (cloud, report) = order_points(&flat.point_in_vehicle, labels, &table, vehicle_from_sensor)
-                .with_context(|| format!("ordering `{}`", path.display()))?;
-            println!(
-                "{}: ordered {} of {} points into {} x {} ({} cell collisions, {} outside the beam table)",
-                path.display(),
-                report.placed,
-                report.cell_of_point.len(),
-                cloud.rows,
-                cloud.cols,
-                report.collisions,
-                report.outside
-            );
-            Ok((cloud, Some(report.cell_of_point)))
+            let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, time_s: None };
+            let (cloud, report) = order_cloud(
+                &flat.point_in_vehicle,
+                &attributes,
+                &table,
+                vehicle_from_sensor,
+                PathChoice::Auto,
+                &UnfoldParams::default(),
+            )
+            .with_context(|| format!("ordering `{}`", path.display()))?;
+            Ok((ReadFrame { cloud, report: Some(report) }, read_ms))
         }
         _ => bail!("`{}`: unsupported file type (expected .pcd or .bin)", path.display()),
     }
@@ -152,13 +160,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let frames = list_inputs(&args.input)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating `{}`", args.out.display()))?;
     for f in &frames {
-        let (cloud, cell_of_point) = read_frame(&f.path, args.rig.as_deref())?;
+        let ReadFrame { cloud, report } = read_frame(&f.path, args.rig.as_deref())?;
+        if let Some(r) = &report {
+            println!(
+                "{}: ordered into {} x {} x {}: {}",
+                f.path.display(),
+                cloud.rows,
+                cloud.cols,
+                cloud.planes,
+                r.summary()
+            );
+        }
         let ground = method
             .classify(&FrameInput { index: f.index, cloud: &cloud, world_from_vehicle: f.pose })
             .with_context(|| format!("classifying `{}`", f.path.display()))?;
-        let bytes: Vec<u8> = match &cell_of_point {
+        let bytes: Vec<u8> = match &report {
             None => ground.iter().map(|&g| u8::from(g)).collect(),
-            Some(cells) => cells.iter().map(|c| c.map_or(0, |c| u8::from(ground[c as usize]))).collect(),
+            Some(r) => decisions_per_point(r, &ground),
         };
         let stem = format!("frame_{:06}", f.index);
         sim::io::atomic::write_bytes_atomic(&args.out.join(format!("{stem}.ground")), &bytes)?;
@@ -169,7 +187,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             sim::picture::save_png(&args.out.join(format!("{stem}.png")), &img)?;
         }
         let ground_count = bytes.iter().filter(|&&b| b == 1).count();
-        println!("{stem}: {} points, {ground_count} ground", bytes.len());
+        let skipped = report.as_ref().map_or(0, |r| r.skipped);
+        println!("{stem}: {} points, {ground_count} ground, {skipped} bad points skipped", bytes.len());
     }
     Ok(())
 }

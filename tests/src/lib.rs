@@ -1,6 +1,8 @@
 //! Shared helpers of the scenario tests in `tests/tests/`: scan a bundled scene with a rig and
 //! classify it, returning the clouds, decisions and scores.
 
+pub mod real_files;
+
 use classifier::{Evaluation, FrameInput, method_by_name};
 use sim::scan::{Frame, ScanConfig, scan};
 

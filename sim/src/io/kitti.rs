@@ -1,13 +1,27 @@
-//! KITTI / SemanticKITTI files: `frame_NNNNNN.bin` (float32 `x y z intensity` per return, grid
-//! order = ring-major), `frame_NNNNNN.label` (uint32 per return: semantic class in the low 16 bits,
+//! KITTI / SemanticKITTI files: `frame_NNNNNN.bin` (float32 `x y z intensity` per return, in scan
+//! order as a real HDL-64E's KITTI files are: see [`scan_order`]), `frame_NNNNNN.label` (uint32
+//! per return: semantic class in the low 16 bits,
 //! instance id in the high 16 bits; instance ids above 65535 keep their low 16 bits) and, for a
 //! single-sensor rig, `frame_NNNNNN.calib.txt` with one line `Tr: r00 r01 r02 t0 r10 ... t2`, the
 //! 3 x 4 row-major `vehicle_from_sensor` transform (points in the `.bin` are then in the sensor
 //! frame, as KITTI's are; multiply by `Tr` to get vehicle-frame points). Intensity is in `[0, 1]`.
 //!
-//! The reader takes a `.bin` and optionally its `.label` and returns a `1 x N` cloud
+//! The reader takes a `.bin` and optionally its `.label` and returns a `1 x N` cloud in file order
 //! (`range_m` = distance from the origin, `column` = point index, ground = the label is a ground
-//! class).
+//! class). It refuses a file whose length is not a whole number of records and a `.label` of
+//! another length; points with NaN or infinite coordinates are kept as no-return cells (NaN
+//! position and range) for the caller to count (`classifier::ordering` skips them, decision 0,
+//! and refuses a file where they are more than a handful).
+//!
+//! # Scan order
+//! Real KITTI `.bin` files store a frame laser by laser, from the top laser down, and each laser's
+//! points as one counter-clockwise turn of azimuth that starts near the front (azimuth 0), passes
+//! the back (where the azimuth wraps from +pi to -pi) and ends just right of the front. The writer
+//! does the same ([`scan_order`]): per echo plane, rows from the top one (highest elevation) down,
+//! and in each row the columns from `cols / 2` (the column at or just left of the front for a
+//! full-turn sensor, whose column 0 is at +pi) down to 0 and then from `cols - 1` down to
+//! `cols / 2 + 1`; cells without a return are skipped. Scan unfolding
+//! (`classifier::ordering`) recovers rows and columns from that order.
 
 use std::path::Path;
 
@@ -22,10 +36,11 @@ use crate::scene::SemanticClass;
 /// `sensor_from_vehicle` when given. Returns `(bin, label, points)`.
 pub fn encode(cloud: &OrderedCloud, sensor_from_vehicle: Option<&Affine3A>) -> Result<(Vec<u8>, Vec<u8>, usize)> {
     cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
-    let n = cloud.returns();
+    let order = scan_order(cloud);
+    let n = order.len();
     let mut bin = Vec::with_capacity(n * 16);
     let mut label = Vec::with_capacity(n * 4);
-    for i in (0..cloud.len()).filter(|&i| cloud.has_return(i)) {
+    for i in order {
         let p = cloud.point_in_vehicle[i];
         let p = sensor_from_vehicle.map_or(p, |t| t.transform_point3(p));
         let mut rec = [0u8; 16];
@@ -38,6 +53,27 @@ pub fn encode(cloud: &OrderedCloud, sensor_from_vehicle: Option<&Affine3A>) -> R
         label.extend_from_slice(&l.to_le_bytes());
     }
     Ok((bin, label, n))
+}
+
+/// The cells of `cloud` that hold a return, in the order the `.bin` stores them (module docs,
+/// "Scan order"): the `k`-th point of the file is cell `scan_order(cloud)[k]`.
+pub fn scan_order(cloud: &OrderedCloud) -> Vec<usize> {
+    let (rows, cols) = (cloud.rows, cloud.cols);
+    let front = cols / 2;
+    let mut order = Vec::with_capacity(cloud.returns());
+    for plane in 0..cloud.planes {
+        for row in (0..rows).rev() {
+            // Counter-clockwise = azimuth increasing = column index decreasing, wrapping.
+            for k in 0..cols {
+                let col = (front + cols - k) % cols;
+                let i = cloud.index(plane, row, col);
+                if cloud.has_return(i) {
+                    order.push(i);
+                }
+            }
+        }
+    }
+    order
 }
 
 /// The calibration text: `Tr:` followed by the 12 row-major entries of `vehicle_from_sensor`.

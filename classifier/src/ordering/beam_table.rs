@@ -1,0 +1,268 @@
+//! The beam table: a sensor's per-laser elevations (and, where known, azimuth and origin offsets)
+//! and its column layout, the physical layout from which a cloud is put back into rows and columns.
+//!
+//! Angles are in the sensor frame, radians; azimuth is counter-clockwise from +x (left positive),
+//! elevation up from the x-y plane. Column 0 is centred on `azimuth_left_rad` and azimuth decreases
+//! by `azimuth_step_rad` per column (the `sim::OrderedCloud` convention), wrapping over a full turn.
+//! Origin offsets follow `sim::sensor::spinning`: a laser's beam starts `horizontal_offset_m` to the
+//! left of its azimuth and `vertical_offset_m` above the sensor origin, so a point at horizontal
+//! distance `d` seen by laser `r` lies at azimuth `beam + asin(h_r / d)` and height
+//! `v_r + sqrt(d^2 - h_r^2) * tan(elevation_r)`: [`TableRows::beam_azimuth`] and
+//! [`TableRows::nearest_row`] undo both.
+
+use crate::error::{ClassifyError, Result};
+
+/// The physical layout needed to order a cloud.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BeamTable {
+    /// Elevation of each beam in the sensor frame, radians (any order; rows are sorted up).
+    pub elevations_rad: Vec<f32>,
+    /// Columns per frame.
+    pub cols: usize,
+    /// Azimuth of the centre of column 0, radians.
+    pub azimuth_left_rad: f32,
+    /// Azimuth step per column, radians (> 0; azimuth decreases with the column).
+    pub azimuth_step_rad: f32,
+    /// Whether the columns cover a full turn (wrap).
+    pub full_turn: bool,
+    /// Per beam (same order as `elevations_rad`): azimuth offset from the encoder angle, radians
+    /// (left positive; empty = all 0). Informational for a destaggered grid, whose columns are the
+    /// beams' own azimuths.
+    pub azimuth_offsets_rad: Vec<f32>,
+    /// Per beam: horizontal origin offset to the left of the beam, metres (empty = all 0).
+    pub horizontal_offsets_m: Vec<f32>,
+    /// Per beam: vertical origin offset above the sensor origin, metres (empty = all 0).
+    pub vertical_offsets_m: Vec<f32>,
+}
+
+impl BeamTable {
+    /// A spinning sensor: `cols` columns over a full turn, column 0 just right of azimuth +pi.
+    pub fn spinning(elevations_rad: Vec<f32>, cols: usize) -> Self {
+        let step = std::f32::consts::TAU / cols.max(1) as f32;
+        Self {
+            elevations_rad,
+            cols,
+            azimuth_left_rad: std::f32::consts::PI - 0.5 * step,
+            azimuth_step_rad: step,
+            full_turn: true,
+            azimuth_offsets_rad: Vec::new(),
+            horizontal_offsets_m: Vec::new(),
+            vertical_offsets_m: Vec::new(),
+        }
+    }
+
+    /// The HDL-64E S2 nominal beam table (64 lasers from +2 to -24.8 degrees: the upper block at
+    /// 1/3 degree, the lower at 1/2 degree) with `cols` columns (KITTI: about 2083 at 10 Hz).
+    pub fn hdl64e(cols: usize) -> Self {
+        let mut e = Vec::with_capacity(64);
+        for i in 0..32 {
+            e.push((2.0 - i as f32 / 3.0).to_radians());
+        }
+        for i in 0..32 {
+            e.push((-8.83 - i as f32 * 0.5).to_radians());
+        }
+        Self::spinning(e, cols)
+    }
+
+    /// The table of a simulated sensor's pattern: row elevations, the columns' nominal azimuths, and
+    /// per row the origin offsets of its beams (read from the row's first firing). Refused for a
+    /// pattern with fewer than 2 rows or columns.
+    pub fn from_pattern(pattern: &sim::sensor::ScanPattern) -> Result<Self> {
+        let az = &pattern.col_azimuth_rad;
+        if pattern.rows < 2 || az.len() < 2 {
+            return Err(ClassifyError::Ordering(format!(
+                "a beam table needs 2 or more rows and columns; the pattern has {} x {}",
+                pattern.rows,
+                az.len()
+            )));
+        }
+        let step = (az[0] - az[az.len() - 1]) / (az.len() - 1) as f32;
+        let full_turn = (step * az.len() as f32 - std::f32::consts::TAU).abs() < 1.5 * step;
+        let mut h = vec![0.0; pattern.rows];
+        let mut v = vec![0.0; pattern.rows];
+        for r in 0..pattern.rows {
+            if let Some(f) = (0..pattern.cols).find_map(|c| pattern.at(r, c)) {
+                let o = f.origin_in_sensor;
+                let d = glam::Vec2::new(f.dir_in_sensor.x, f.dir_in_sensor.y).normalize_or_zero();
+                // Left of the beam = d rotated by +90 degrees.
+                h[r] = -o.x * d.y + o.y * d.x;
+                v[r] = o.z;
+            }
+        }
+        let any = |x: &[f32]| x.iter().any(|&a| a != 0.0);
+        Ok(Self {
+            elevations_rad: pattern.row_elevation_rad.clone(),
+            cols: pattern.cols,
+            azimuth_left_rad: az[0],
+            azimuth_step_rad: step,
+            full_turn,
+            azimuth_offsets_rad: Vec::new(),
+            horizontal_offsets_m: if any(&h) { h } else { Vec::new() },
+            vertical_offsets_m: if any(&v) { v } else { Vec::new() },
+        })
+    }
+
+    /// Checks the table and returns its rows sorted up.
+    pub fn rows(&self) -> Result<TableRows> {
+        let n = self.elevations_rad.len();
+        if !(2..=u16::MAX as usize).contains(&n) {
+            return Err(ClassifyError::Ordering(format!("beam table has {n} elevations, needs 2 ..= 65535")));
+        }
+        if self.cols < 2 || self.cols > 1 << 20 {
+            return Err(ClassifyError::Ordering(format!("beam table has {} columns, needs 2 ..= 2^20", self.cols)));
+        }
+        if !(self.azimuth_step_rad.is_finite() && self.azimuth_step_rad > 0.0 && self.azimuth_left_rad.is_finite()) {
+            return Err(ClassifyError::Ordering("azimuth step must be finite and > 0, left azimuth finite".into()));
+        }
+        for (name, v) in [
+            ("azimuth offsets", &self.azimuth_offsets_rad),
+            ("horizontal offsets", &self.horizontal_offsets_m),
+            ("vertical offsets", &self.vertical_offsets_m),
+        ] {
+            if !v.is_empty() && v.len() != n {
+                return Err(ClassifyError::Ordering(format!("beam table has {n} elevations but {} {name}", v.len())));
+            }
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(ClassifyError::Ordering(format!("beam table has a non-finite value in its {name}")));
+            }
+        }
+        if self.elevations_rad.iter().any(|x| !x.is_finite()) {
+            return Err(ClassifyError::Ordering("beam table has a non-finite elevation".into()));
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| self.elevations_rad[a].total_cmp(&self.elevations_rad[b]));
+        let pick = |v: &[f32]| -> Vec<f32> { order.iter().map(|&k| v.get(k).copied().unwrap_or(0.0)).collect() };
+        let elevation_rad = pick(&self.elevations_rad);
+        if elevation_rad.windows(2).any(|w| w[1] - w[0] <= 0.0) {
+            return Err(ClassifyError::Ordering("beam table has two beams at the same elevation".into()));
+        }
+        let horizontal_m = pick(&self.horizontal_offsets_m);
+        let vertical_m = pick(&self.vertical_offsets_m);
+        let mean_vertical_m = vertical_m.iter().sum::<f32>() / n as f32;
+        Ok(TableRows {
+            tan_elevation: elevation_rad.iter().map(|e| e.tan()).collect(),
+            elevation_rad,
+            horizontal_m,
+            vertical_m,
+            mean_vertical_m,
+            cols: self.cols,
+            azimuth_left_rad: self.azimuth_left_rad,
+            azimuth_step_rad: self.azimuth_step_rad,
+            full_turn: self.full_turn,
+        })
+    }
+}
+
+/// A checked beam table with its rows sorted by elevation (row 0 lowest).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableRows {
+    /// Elevation per row, radians, increasing.
+    pub elevation_rad: Vec<f32>,
+    /// `tan(elevation)` per row.
+    pub tan_elevation: Vec<f32>,
+    /// Horizontal origin offset per row, metres (left of the beam).
+    pub horizontal_m: Vec<f32>,
+    /// Vertical origin offset per row, metres.
+    pub vertical_m: Vec<f32>,
+    /// Mean vertical offset, metres (for a first guess of a point's row).
+    pub mean_vertical_m: f32,
+    /// Columns.
+    pub cols: usize,
+    /// Azimuth of column 0's centre, radians.
+    pub azimuth_left_rad: f32,
+    /// Azimuth step per column, radians.
+    pub azimuth_step_rad: f32,
+    /// Whether the columns wrap over a full turn.
+    pub full_turn: bool,
+}
+
+impl TableRows {
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.elevation_rad.len()
+    }
+
+    /// Whether the table has no rows (never, once checked).
+    pub fn is_empty(&self) -> bool {
+        self.elevation_rad.is_empty()
+    }
+
+    /// `tan(elevation)` of `p` (sensor frame) seen from the mean beam origin height.
+    pub fn rough_tan(&self, p: glam::Vec3) -> f32 {
+        (p.z - self.mean_vertical_m) / (p.x * p.x + p.y * p.y).sqrt().max(1e-6)
+    }
+
+    /// The row whose beam passes closest to `p` (sensor frame, compared as `tan(elevation)` with
+    /// the row's origin offsets undone), the point's `tan(elevation)` seen from that row's origin,
+    /// and whether `p` lies beyond the table's lowest or highest beam by more than half the gap to
+    /// its neighbour.
+    pub fn nearest_row(&self, p: glam::Vec3) -> (usize, f32, bool) {
+        let d2 = p.x * p.x + p.y * p.y;
+        let n = self.len();
+        let tan = &self.tan_elevation;
+        let t0 = (p.z - self.mean_vertical_m) / d2.sqrt().max(1e-6);
+        let guess = tan.partition_point(|&x| x < t0).min(n - 1);
+        let fine = |r: usize| {
+            let h = self.horizontal_m[r];
+            (p.z - self.vertical_m[r]) / (d2 - h * h).max(1e-12).sqrt()
+        };
+        let (lo, hi) = (guess.saturating_sub(3), (guess + 3).min(n - 1));
+        let mut best = (f32::INFINITY, guess, t0);
+        for (r, &tan_r) in tan.iter().enumerate().take(hi + 1).skip(lo) {
+            let f = fine(r);
+            let e = (f - tan_r).abs();
+            if e < best.0 {
+                best = (e, r, f);
+            }
+        }
+        let (_, r, f) = best;
+        let outside = (r == 0 && tan[0] - f > 0.5 * (tan[1] - tan[0]))
+            || (r == n - 1 && f - tan[n - 1] > 0.5 * (tan[n - 1] - tan[n - 2]));
+        (r, f, outside)
+    }
+
+    /// Azimuth of the beam of row `row` that hit `p` (sensor frame): the point's azimuth less the
+    /// parallax of the row's horizontal origin offset, radians.
+    pub fn beam_azimuth(&self, p: glam::Vec3, row: usize) -> f32 {
+        let az = fast_atan2(p.y, p.x);
+        let h = self.horizontal_m[row];
+        if h == 0.0 {
+            return az;
+        }
+        let d = (p.x * p.x + p.y * p.y).sqrt().max(h.abs() * 1.0001);
+        az - (h / d).asin()
+    }
+
+    /// Fractional column steps from column 0 to azimuth `az` (wrapped into one turn for a full-turn
+    /// table); column = the nearest integer.
+    pub fn column_steps(&self, az: f32) -> f32 {
+        let steps = (self.azimuth_left_rad - az) / self.azimuth_step_rad;
+        if self.full_turn { steps.rem_euclid(std::f32::consts::TAU / self.azimuth_step_rad) } else { steps }
+    }
+}
+
+/// `atan2(y, x)` within 1e-6 rad (a minimax polynomial on `[0, 1]` and octant folding): the
+/// azimuth of every point of a frame at a fraction of libm's cost.
+#[inline]
+pub fn fast_atan2(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (num, den, swap) = if ay > ax { (ax, ay, true) } else { (ay, ax, false) };
+    if den == 0.0 {
+        return if x.is_sign_negative() { if y.is_sign_negative() { -PI } else { PI } } else { 0.0f32.copysign(y) };
+    }
+    let t = num / den;
+    let t2 = t * t;
+    let mut a = t
+        * (0.999_996_1
+            + t2 * (-0.333_172_8
+                + t2 * (0.198_069_7
+                    + t2 * (-0.132_299_9 + t2 * (0.079_560_77 + t2 * (-0.033_548_71 + t2 * 0.006_793_221))))));
+    if swap {
+        a = FRAC_PI_2 - a;
+    }
+    if x < 0.0 {
+        a = PI - a;
+    }
+    if y < 0.0 { -a } else { a }
+}

@@ -1,0 +1,165 @@
+//! Ordering recovery: puts a cloud from another source (a KITTI `.bin`, a shuffled or merged cloud)
+//! back into ring x column order, so the method runs on it (the paper: "it can be easily computed
+//! from the physical sensor layout"), and keeps every point.
+//!
+//! Paths, chosen per cloud ([`order_cloud`], [`OrderingPath`]):
+//! - **scan unfolding** ([`unfold`]) for clouds in scan order (KITTI `.bin`): rings from the turns
+//!   of the azimuth, matched to the beam table's rows;
+//! - **the beam table** ([`table`]) for clouds out of order: each point's row from its elevation,
+//!   with the table's origin offsets undone ([`beam_table`]); taken when unfolding is refused, and
+//!   the report says why;
+//!
+//! Columns come from each point's beam azimuth on every path. Points that share a cell are all kept
+//! ([`placement`]): the adjacent free column on the point's side, else a further plane of the same
+//! cell. Points with NaN or infinite coordinates are skipped (decision 0) and counted; more than
+//! [`MAX_BAD_FRACTION`] of them refuses the cloud. Points at exactly (0, 0, 0) are no-returns
+//! (skipped, counted). [`OrderingReport`] gives the cell of every input point and what each step
+//! placed.
+
+pub mod beam_table;
+pub mod placement;
+pub mod report;
+pub mod table;
+pub mod unfold;
+
+use glam::{Affine3A, Vec3};
+use sim::{OrderedCloud, SemanticClass};
+
+pub use beam_table::{BeamTable, TableRows};
+pub use placement::PointAttributes;
+pub use report::{OrderingPath, OrderingReport};
+pub use unfold::UnfoldParams;
+
+use crate::error::{ClassifyError, Result};
+
+/// Largest fraction of bad points (NaN or infinite coordinates) a cloud may hold; they are
+/// skipped and counted. A cloud with more is refused.
+pub const MAX_BAD_FRACTION: f64 = 0.01;
+
+/// Which paths [`order_cloud`] may take.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PathChoice {
+    /// Unfold where the order allows, else the beam table.
+    #[default]
+    Auto,
+    /// Only the beam table (the order of the points is ignored).
+    BeamTable,
+    /// Only unfolding (refused where the order does not unfold).
+    Unfold,
+}
+
+/// Indices of the usable points; counts bad points and no-returns in `report`.
+fn usable(points: &[Vec3], report: &mut OrderingReport) -> Result<Vec<u32>> {
+    if points.len() > u32::MAX as usize / 2 {
+        return Err(ClassifyError::Ordering(format!("{} points are too many", points.len())));
+    }
+    let mut valid = Vec::with_capacity(points.len());
+    for (k, p) in points.iter().enumerate() {
+        if !p.is_finite() {
+            report.skipped += 1;
+        } else if *p == Vec3::ZERO {
+            report.no_returns += 1;
+        } else {
+            valid.push(k as u32);
+        }
+    }
+    if report.skipped as f64 > MAX_BAD_FRACTION * points.len() as f64 {
+        return Err(ClassifyError::Ordering(format!(
+            "{} of {} points have NaN or infinite coordinates (at most {} % may)",
+            report.skipped,
+            points.len(),
+            MAX_BAD_FRACTION * 100.0
+        )));
+    }
+    Ok(valid)
+}
+
+/// Orders `points_in_sensor` into the grid of `table`, by unfolding or the beam table as `choice`
+/// allows; points go to the vehicle frame through `vehicle_from_sensor`. Every usable point gets a
+/// cell ([`OrderingReport::cell_of_point`]).
+pub fn order_cloud(
+    points_in_sensor: &[Vec3],
+    attributes: &PointAttributes<'_>,
+    table: &BeamTable,
+    vehicle_from_sensor: Affine3A,
+    choice: PathChoice,
+    params: &UnfoldParams,
+) -> Result<(OrderedCloud, OrderingReport)> {
+    let rows = table.rows()?;
+    let n = points_in_sensor.len();
+    for (name, len) in [
+        ("labels", attributes.labels.map(<[SemanticClass]>::len)),
+        ("intensities", attributes.intensity.map(<[f32]>::len)),
+        ("times", attributes.time_s.map(<[f64]>::len)),
+    ] {
+        if len.is_some_and(|l| l != n) {
+            return Err(ClassifyError::Ordering(format!("{name} and points differ in length")));
+        }
+    }
+    let mut report = OrderingReport { cell_of_point: vec![None; n], ..OrderingReport::default() };
+    let valid = usable(points_in_sensor, &mut report)?;
+    let wishes = match choice {
+        PathChoice::BeamTable => {
+            report.path = OrderingPath::BeamTable;
+            table::table_wishes(points_in_sensor, &valid, &rows, &mut report)
+        }
+        PathChoice::Unfold | PathChoice::Auto => {
+            match unfold::unfold_wishes(points_in_sensor, &valid, &rows, params, &mut report) {
+                Ok(w) => {
+                    report.path = OrderingPath::Unfolded;
+                    w
+                }
+                Err(why) if choice == PathChoice::Auto => {
+                    report.path = OrderingPath::BeamTable;
+                    report.fallback = Some(why);
+                    report.rings_found = 0;
+                    table::table_wishes(points_in_sensor, &valid, &rows, &mut report)
+                }
+                Err(why) => return Err(ClassifyError::Ordering(format!("the points do not unfold: {why}"))),
+            }
+        }
+    };
+    let (cells, planes) = placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, &mut report);
+    let cloud = placement::build_cloud(
+        points_in_sensor,
+        attributes,
+        &wishes,
+        &cells,
+        rows.len(),
+        rows.cols,
+        planes,
+        vehicle_from_sensor,
+        &mut report,
+    );
+    Ok((cloud, report))
+}
+
+/// Orders `points_in_sensor` (with optional labels) by the beam table alone, ignoring their order
+/// (the original interface; [`order_cloud`] chooses the path). Labels make the cloud's `label` and
+/// `ground` fields.
+pub fn order_points(
+    points_in_sensor: &[Vec3],
+    labels: Option<&[SemanticClass]>,
+    table: &BeamTable,
+    vehicle_from_sensor: Affine3A,
+) -> Result<(OrderedCloud, OrderingReport)> {
+    let attributes = PointAttributes { labels, ..PointAttributes::default() };
+    order_cloud(
+        points_in_sensor,
+        &attributes,
+        table,
+        vehicle_from_sensor,
+        PathChoice::BeamTable,
+        &UnfoldParams::default(),
+    )
+}
+
+/// Maps per-cell decisions back to the input points: one byte per point, 1 = ground; skipped
+/// points are 0.
+pub fn decisions_per_point(report: &OrderingReport, ground: &[bool]) -> Vec<u8> {
+    report
+        .cell_of_point
+        .iter()
+        .map(|c| c.map_or(0, |c| u8::from(ground.get(c as usize).copied().unwrap_or(false))))
+        .collect()
+}

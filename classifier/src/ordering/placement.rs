@@ -1,0 +1,165 @@
+//! Putting points into cells so that every point keeps one: each point names a row and a
+//! fractional column; the point closest to a cell's column centre keeps the cell, a point that loses
+//! it moves to the adjacent column on its side if that is free, and otherwise stays in its cell on
+//! a further plane (plane 1, 2, ...), as a second echo would. The classifier decides planes > 0
+//! from the nearest plane-0 return (`nitsch::echoes_from_plane0`), so no point is left out.
+
+use glam::{Affine3A, Vec3};
+use sim::{OrderedCloud, SemanticClass};
+
+use super::report::OrderingReport;
+
+/// Where one point wants to go.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Wish {
+    /// Input point index.
+    pub point: u32,
+    /// Row.
+    pub row: u32,
+    /// Fractional column steps (column = nearest integer, wrapped for a full turn).
+    pub steps: f32,
+}
+
+/// The per-point attributes carried into the cloud.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PointAttributes<'a> {
+    /// Intensity per input point.
+    pub intensity: Option<&'a [f32]>,
+    /// Semantic label per input point (makes `label` and `ground`).
+    pub labels: Option<&'a [SemanticClass]>,
+    /// Time per input point, seconds.
+    pub time_s: Option<&'a [f64]>,
+}
+
+/// Places `wishes` into a `rows x cols` grid (planes added as needed) and fills `report`'s
+/// `cell_of_point`, `placed`, `moved` and `stacked`.
+pub(crate) fn place(
+    wishes: &[Wish],
+    rows: usize,
+    cols: usize,
+    full_turn: bool,
+    report: &mut OrderingReport,
+) -> (Vec<u32>, usize) {
+    const FREE: u32 = u32::MAX;
+    let n = rows * cols;
+    // owner[cell] = index into `wishes`; `off` its distance from the column centre.
+    let mut owner = vec![FREE; n];
+    let mut off = vec![0f32; n];
+    let mut cell_of_wish = vec![FREE; wishes.len()];
+    let col_of = |steps: f32| -> Option<(usize, f32, Option<usize>)> {
+        let mut col = steps.round();
+        if full_turn && col >= cols as f32 {
+            col -= cols as f32;
+        }
+        if !(col >= 0.0 && (col as usize) < cols) {
+            return None;
+        }
+        let c = col as usize;
+        let o = (steps - col).abs().min((steps - col - cols as f32).abs());
+        let side = if steps >= col && steps - col < 0.5 * cols as f32 { c as isize + 1 } else { c as isize - 1 };
+        let alt = if full_turn {
+            Some(side.rem_euclid(cols as isize) as usize)
+        } else {
+            usize::try_from(side).ok().filter(|&a| a < cols)
+        };
+        Some((c, o, alt))
+    };
+    let mut losers: Vec<u32> = Vec::new();
+    for (w, wish) in wishes.iter().enumerate() {
+        let Some((c, o, _)) = col_of(wish.steps) else {
+            losers.push(w as u32);
+            continue;
+        };
+        let cell = wish.row as usize * cols + c;
+        let prev = owner[cell];
+        if prev == FREE {
+            owner[cell] = w as u32;
+            off[cell] = o;
+            cell_of_wish[w] = cell as u32;
+        } else if off[cell] <= o {
+            losers.push(w as u32);
+        } else {
+            cell_of_wish[prev as usize] = FREE;
+            losers.push(prev);
+            owner[cell] = w as u32;
+            off[cell] = o;
+            cell_of_wish[w] = cell as u32;
+        }
+    }
+    report.placed = wishes.len() - losers.len();
+    // Losers: the adjacent column on their side if free, else a further plane of their own cell.
+    let mut depth: Vec<u8> = Vec::new();
+    let mut stack: Vec<(u32, usize, u8)> = Vec::new();
+    for &w in &losers {
+        let wish = wishes[w as usize];
+        let (c, alt) = match col_of(wish.steps) {
+            Some((c, _, alt)) => (c, alt),
+            None => (if wish.steps < 0.0 { 0 } else { cols - 1 }, None),
+        };
+        let row0 = wish.row as usize * cols;
+        if let Some(a) = alt
+            && owner[row0 + a] == FREE
+        {
+            owner[row0 + a] = w;
+            cell_of_wish[w as usize] = (row0 + a) as u32;
+            report.moved += 1;
+            continue;
+        }
+        if depth.is_empty() {
+            depth = vec![0; n];
+        }
+        let cell = row0 + c;
+        depth[cell] = depth[cell].saturating_add(1);
+        stack.push((w, cell, depth[cell]));
+        report.stacked += 1;
+    }
+    let planes = 1 + stack.iter().map(|s| s.2 as usize).max().unwrap_or(0);
+    for (w, cell, d) in stack {
+        cell_of_wish[w as usize] = (d as usize * n + cell) as u32;
+    }
+    (cell_of_wish, planes)
+}
+
+/// Builds the cloud: the points of `wishes` in their cells (`cell_of_wish`), moved to the vehicle
+/// frame by `vehicle_from_sensor`; every cell's `ring` is its row and `column` its column.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn build_cloud(
+    points_in_sensor: &[Vec3],
+    attributes: &PointAttributes<'_>,
+    wishes: &[Wish],
+    cell_of_wish: &[u32],
+    rows: usize,
+    cols: usize,
+    planes: usize,
+    vehicle_from_sensor: Affine3A,
+    report: &mut OrderingReport,
+) -> OrderedCloud {
+    let mut cloud = OrderedCloud::empty(rows, cols, planes);
+    for (i, (r, c)) in cloud.ring.iter_mut().zip(cloud.column.iter_mut()).enumerate() {
+        let cell = i % (rows * cols);
+        *r = (cell / cols) as u16;
+        *c = (cell % cols) as u32;
+    }
+    let identity = vehicle_from_sensor == Affine3A::IDENTITY;
+    for (wish, &cell) in wishes.iter().zip(cell_of_wish) {
+        let k = wish.point as usize;
+        let cell = cell as usize;
+        let p = points_in_sensor[k];
+        cloud.point_in_vehicle[cell] = if identity { p } else { vehicle_from_sensor.transform_point3(p) };
+        cloud.range_m[cell] = p.length();
+        cloud.sensor[cell] = 0;
+        cloud.echo[cell] = (cell / (rows * cols)) as u8;
+        if let Some(v) = attributes.intensity {
+            cloud.intensity[cell] = v[k];
+        }
+        if let Some(t) = attributes.time_s {
+            cloud.time_s[cell] = t[k];
+        }
+        if let Some(l) = attributes.labels {
+            cloud.label[cell] = l[k];
+            cloud.ground[cell] = l[k].is_ground();
+        }
+        report.cell_of_point[k] = Some(cell as u32);
+    }
+    cloud
+}

@@ -1,0 +1,89 @@
+//! What ordering did with a cloud's points: the path taken, the cell of every input point, and how
+//! many points each step placed.
+
+use serde::Serialize;
+
+/// How a cloud was put into rows and columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OrderingPath {
+    /// Scan unfolding: rings from the file's scan order (azimuth turns), columns from azimuth.
+    Unfolded,
+    /// The beam table: each point's row from its elevation, column from its azimuth.
+    #[default]
+    BeamTable,
+    /// A `ring` field per point: rows from the field, columns from azimuth.
+    RingField,
+    /// An organized cloud: its own grid, rows put in elevation order.
+    Organized,
+}
+
+impl OrderingPath {
+    /// The path's name as reports print it.
+    pub fn name(self) -> &'static str {
+        match self {
+            OrderingPath::Unfolded => "unfolded",
+            OrderingPath::BeamTable => "beam-table",
+            OrderingPath::RingField => "ring-field",
+            OrderingPath::Organized => "organized",
+        }
+    }
+}
+
+/// What ordering did with the points.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct OrderingReport {
+    /// The path taken.
+    pub path: OrderingPath,
+    /// Why the preferred path (unfolding) was not taken, where it was tried.
+    pub fallback: Option<String>,
+    /// Cell index (over all planes) of each input point; `None` only for skipped bad points.
+    #[serde(skip)]
+    pub cell_of_point: Vec<Option<u32>>,
+    /// Rings found by unfolding (0 on the other paths).
+    pub rings_found: usize,
+    /// Points placed in the cell their row and azimuth name.
+    pub placed: usize,
+    /// Points whose cell was taken and that moved to the adjacent free column on their side.
+    pub moved: usize,
+    /// Points whose cell and adjacent column were taken, kept on a further plane of the same cell.
+    pub stacked: usize,
+    /// Points beyond the beam table's lowest or highest beam (placed in the edge row, counted here
+    /// as well).
+    pub outside: usize,
+    /// Bad points skipped (NaN or infinite coordinates, a ring value out of range): decision 0.
+    pub skipped: usize,
+    /// No-return points (0, 0, 0) skipped: decision 0.
+    pub no_returns: usize,
+}
+
+impl OrderingReport {
+    /// Points that got a cell (placed + moved + stacked).
+    pub fn kept(&self) -> usize {
+        self.placed + self.moved + self.stacked
+    }
+
+    /// One line for the command line.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "path {}: {} points: {} in their cell, {} moved to the adjacent column, {} on a second plane, {} skipped (bad), {} no-returns",
+            self.path.name(),
+            self.cell_of_point.len(),
+            self.placed,
+            self.moved,
+            self.stacked,
+            self.skipped,
+            self.no_returns
+        );
+        if self.rings_found > 0 {
+            s.push_str(&format!(", {} rings unfolded", self.rings_found));
+        }
+        if self.outside > 0 {
+            s.push_str(&format!(", {} beyond the beam table (kept in the edge row)", self.outside));
+        }
+        if let Some(f) = &self.fallback {
+            s.push_str(&format!(" (not unfolded: {f})"));
+        }
+        s
+    }
+}

@@ -1,0 +1,97 @@
+//! Our scans through the paths real files take: a frame written as a KITTI `.bin` (scan order, or
+//! shuffled), read back, ordered ([`classifier::ordering`]) and classified, against the same frame
+//! classified on its own grid (what the organized `.pcd` gives). Used by `tests/tests/real_files.rs`
+//! and `examples/real_files_targets.rs`.
+
+use classifier::ordering::{BeamTable, OrderingReport, PathChoice, PointAttributes, UnfoldParams, order_cloud};
+use classifier::{Confusion, method_by_name};
+use glam::Vec3;
+use sim::scan::{ScanConfig, scan};
+
+/// One frame compared through the `.bin` path and on its own grid.
+#[derive(Clone, Debug)]
+pub struct BinComparison {
+    /// F1 of the method on the frame's own grid (the organized PCD path).
+    pub f1_grid: f64,
+    /// F1 of the method through the `.bin` path, over the same points.
+    pub f1_bin: f64,
+    /// Fraction of the file's points ordered into their true cell (any plane counts as the cell).
+    pub true_cell: f64,
+    /// Fraction of points whose decision equals the grid path's decision.
+    pub same_decision: f64,
+    /// What ordering did.
+    pub report: OrderingReport,
+    /// Points in the file.
+    pub points: usize,
+}
+
+/// Scans frame 0 of `scene` (bundled, `seed`) with the single-sensor rig preset `rig`, writes it
+/// as KITTI `.bin` bytes (sensor frame, scan order; `shuffle` permutes the points with a fixed
+/// permutation), reads them back, orders them with the rig's beam table (`choice`) and classifies
+/// with `method` both ways.
+pub fn compare_bin(
+    scene: &str,
+    rig: &str,
+    seed: u64,
+    method: &str,
+    shuffle: bool,
+    choice: PathChoice,
+) -> BinComparison {
+    let loaded = scenes::load(scene, seed).expect("bundled scene");
+    let rig = sim::Rig::preset(rig).expect("rig preset");
+    assert_eq!(rig.sensors.len(), 1, "single-sensor rig");
+    let config = ScanConfig { seed, frames: 1, ego_z_m: loaded.ego_ground_z_m, ..ScanConfig::default() };
+    let frames = scan(&loaded.mesh, &rig, &config).expect("scan");
+    let cloud = &frames[0].cloud;
+    let vehicle_from_sensor = rig.sensors[0].mount.vehicle_from_sensor();
+    let sensor_from_vehicle = vehicle_from_sensor.inverse();
+    let (bin, _, n) = sim::io::kitti::encode(cloud, Some(&sensor_from_vehicle)).expect("encode");
+    let mut order = sim::io::kitti::scan_order(cloud);
+    assert_eq!(order.len(), n);
+    let flat = sim::io::kitti::read_bytes(std::path::Path::new("frame.bin"), &bin, None).expect("read");
+    let mut points: Vec<Vec3> = flat.point_in_vehicle.clone();
+    let mut intensity: Vec<f32> = flat.intensity.clone();
+    if shuffle {
+        // A fixed permutation (Fisher-Yates with a multiplicative hash).
+        for k in (1..n).rev() {
+            let j = ((k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 17) as usize % (k + 1);
+            points.swap(k, j);
+            intensity.swap(k, j);
+            order.swap(k, j);
+        }
+    }
+    let labels: Vec<sim::SemanticClass> = order.iter().map(|&c| cloud.label[c]).collect();
+    let table = BeamTable::from_pattern(&rig.sensors[0].spec.pattern()).expect("table");
+    let attributes = PointAttributes { intensity: Some(&intensity), labels: Some(&labels), time_s: None };
+    let (ordered, report) =
+        order_cloud(&points, &attributes, &table, vehicle_from_sensor, choice, &UnfoldParams::default())
+            .expect("order");
+    let mut m = method_by_name(method, 0).expect("method");
+    let grid_decisions =
+        m.classify(&classifier::FrameInput { index: 0, cloud, world_from_vehicle: None }).expect("classify grid");
+    let mut m = method_by_name(method, 0).expect("method");
+    let bin_decisions = m
+        .classify(&classifier::FrameInput { index: 0, cloud: &ordered, world_from_vehicle: None })
+        .expect("classify bin");
+    let per_point = classifier::ordering::decisions_per_point(&report, &bin_decisions);
+    let (mut cg, mut cb) = (Confusion::default(), Confusion::default());
+    let (mut true_cell, mut same) = (0usize, 0usize);
+    let plane = cloud.rows * cloud.cols;
+    for (k, &cell) in order.iter().enumerate() {
+        let truth = cloud.ground[cell];
+        cg.add(truth, grid_decisions[cell]);
+        cb.add(truth, per_point[k] == 1);
+        same += usize::from(grid_decisions[cell] == (per_point[k] == 1));
+        if report.cell_of_point[k].is_some_and(|c| c as usize % plane == cell % plane) {
+            true_cell += 1;
+        }
+    }
+    BinComparison {
+        f1_grid: cg.f1(),
+        f1_bin: cb.f1(),
+        true_cell: true_cell as f64 / n.max(1) as f64,
+        same_decision: same as f64 / n.max(1) as f64,
+        report,
+        points: n,
+    }
+}
