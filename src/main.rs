@@ -2,6 +2,7 @@
 //! writes labelled ordered clouds, classifies ground points and evaluates the result.
 
 mod cli;
+mod plot;
 
 use clap::Parser;
 

@@ -37,7 +37,7 @@ fn assert_uniform(elevations: &[f64], spacing_deg: f64) {
 
 #[test]
 fn every_preset_validates() {
-    let expected_sensors = [1usize, 4, 7, 1, 1, 1, 1, 1];
+    let expected_sensors = [1usize, 4, 7, 1, 1, 1, 1, 1, 1];
     assert_eq!(PRESETS.len(), expected_sensors.len());
     for (name, n) in PRESETS.iter().zip(expected_sensors) {
         let rig = Rig::preset(name).unwrap();
@@ -139,6 +139,12 @@ fn example_rig_files_load() {
     let nod = Rig::load(rigs_dir().join("nodding-180.toml").to_str().unwrap()).unwrap();
     let p = nod.sensors[0].spec.pattern();
     assert_eq!((p.rows, p.cols), (200, 721));
+    // The preset of the paper's sparse scene is the same sensor at the same mount.
+    let preset = Rig::preset("utm30lx-nodding-180").unwrap();
+    assert_eq!(
+        (preset.sensors[0].spec.clone(), preset.sensors[0].mount),
+        (nod.sensors[0].spec.clone(), nod.sensors[0].mount)
+    );
 }
 
 #[test]

@@ -59,3 +59,18 @@ pub fn load_rig(name_or_file: &str) -> anyhow::Result<Rig> {
 pub fn split_list(s: &str) -> Vec<String> {
     s.split(',').map(str::trim).filter(|x| !x.is_empty()).map(str::to_string).collect()
 }
+
+/// Scans `frames` frames of a scene (name or file, generated with `seed`) with a rig (name or
+/// file), standing still; `ideal` turns measurement effects off.
+pub fn scan_standing(
+    scene: &str,
+    rig: &str,
+    seed: u64,
+    frames: usize,
+    ideal: bool,
+) -> anyhow::Result<Vec<sim::scan::Frame>> {
+    let loaded = load_scene_full(scene, seed)?;
+    let rig = load_rig(rig)?;
+    let config = sim::scan::ScanConfig { seed, frames, ideal, ego_z_m: loaded.ego_ground_z_m, ..Default::default() };
+    sim::scan::scan(&loaded.mesh, &rig, &config).with_context(|| format!("scanning `{scene}`"))
+}

@@ -3,6 +3,8 @@
 //! like Table I of Nitsch et al. With `--json FILE` the same numbers are written atomically as
 //! `{"methods": {NAME: {"acc", "fpr", "precision", "recall", "f1", "iou"}}}`; `--details` also
 //! prints the per-frame means and the breakdown by class and range band.
+//!
+//! `--paper mcdaniel` runs McDaniel et al.'s own evaluation instead ([`super::eval_paper`]).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -16,11 +18,17 @@ use sim::scan::ScanConfig;
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Scene name or TOML file.
-    #[arg(long)]
-    scene: String,
+    #[arg(long, required_unless_present = "paper")]
+    scene: Option<String>,
     /// Rig name or TOML file.
-    #[arg(long)]
-    rig: String,
+    #[arg(long, required_unless_present = "paper")]
+    rig: Option<String>,
+    /// Run a paper's own evaluation instead (`mcdaniel`: Tables I-III and the ROC figure of seed 002).
+    #[arg(long, conflicts_with_all = ["scene", "rig", "methods", "frames", "speed", "details"])]
+    paper: Option<String>,
+    /// Output directory of `--paper` (figures).
+    #[arg(long, default_value = "out/paper-mcdaniel")]
+    out: PathBuf,
     /// Comma-separated method names (see `groundtruth list`).
     #[arg(
         long,
@@ -49,6 +57,21 @@ pub struct Args {
 
 /// Runs `groundtruth eval`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(paper) = &args.paper {
+        if paper != "mcdaniel" {
+            anyhow::bail!("--paper `{paper}`: known papers: mcdaniel");
+        }
+        let paper_args = super::eval_paper::PaperArgs {
+            seed: args.seed,
+            ideal: args.ideal,
+            out: args.out.clone(),
+            json: args.json.clone(),
+        };
+        return super::eval_paper::run(&paper_args);
+    }
+    let (Some(scene_name), Some(rig_name)) = (&args.scene, &args.rig) else {
+        anyhow::bail!("--scene and --rig are required (or --paper mcdaniel)");
+    };
     let names = super::common::split_list(&args.methods);
     if names.is_empty() {
         anyhow::bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));
@@ -57,8 +80,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for n in &names {
         method_by_name(n, args.seed)?;
     }
-    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
-    let rig = super::common::load_rig(&args.rig)?;
+    let scene = super::common::load_scene_full(scene_name, args.seed)?;
+    let rig = super::common::load_rig(rig_name)?;
     let config = ScanConfig {
         seed: args.seed,
         frames: args.frames,
@@ -68,7 +91,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ..Default::default()
     };
     let frames = sim::scan::scan(&scene.mesh, &rig, &config).context("scanning")?;
-    println!("scene {} rig {} frames {} seed {}", args.scene, args.rig, frames.len(), args.seed);
+    println!("scene {scene_name} rig {rig_name} frames {} seed {}", frames.len(), args.seed);
     println!("{:<24} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}", "method", "acc", "FPR", "precision", "recall", "F1", "IoU");
     let mut json: BTreeMap<String, Scores> = BTreeMap::new();
     for name in &names {

@@ -7,12 +7,14 @@ mod classify;
 mod common;
 mod demo;
 mod eval;
+mod eval_paper;
 mod list;
 mod render;
 mod render_scan;
 mod render_scene;
 mod scan;
 mod scene;
+mod train;
 
 use clap::{Parser, Subcommand};
 
@@ -39,8 +41,10 @@ enum Command {
     Render(render::Args),
     /// Classify ground points in scanned clouds.
     Classify(classify::Args),
-    /// Scan, classify and score methods on a scene (Table I style).
+    /// Scan, classify and score methods on a scene (Table I style), or a paper's evaluation (`--paper mcdaniel`).
     Eval(eval::Args),
+    /// Train a learning method (McDaniel et al.'s SVM) on scans and write the model (JSON).
+    Train(train::Args),
     /// Benchmarks that print one JSON object.
     #[command(subcommand)]
     Bench(bench::Command),
@@ -56,6 +60,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(a) => render::run(a),
         Command::Classify(a) => classify::run(a),
         Command::Eval(a) => eval::run(a),
+        Command::Train(a) => train::run(a),
         Command::Bench(c) => bench::run(c),
     }
 }

@@ -72,3 +72,23 @@ fn plane_fitting_is_clearly_worse_than_the_method_on_rural_roads() {
     eprintln!("rural: nitsch {nitsch:?} ransac {ransac:?}");
     assert!(nitsch.acc > ransac.acc + 0.1, "nitsch accuracy {} vs ransac {}", nitsch.acc, ransac.acc);
 }
+
+#[test]
+fn nitsch_on_the_270_deg_nodding_rig_finds_the_ground_as_at_180() {
+    // The rear flanks of the 270 deg fan run down in elevation as the nod goes up; the method flips
+    // those columns' rows (classifier::nitsch::row_order) and must then do as well as at 180 deg.
+    let rig_180 = sim::Rig::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../sim/rigs/nodding-180.toml")).unwrap();
+    let rig_270 = sim::Rig::preset("utm30lx-nodding").unwrap();
+    for name in ["forest-sparse", "forest-moderate", "forest-dense"] {
+        let scene = scenes::load(name, 0).unwrap();
+        let config = sim::scan::ScanConfig { ideal: true, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
+        let f1 = |rig: &sim::Rig| {
+            let frames = sim::scan::scan(&scene.mesh, rig, &config).unwrap();
+            gt_tests::classify(frames, "nitsch").eval.pooled.scores()
+        };
+        let (s180, s270) = (f1(&rig_180), f1(&rig_270));
+        eprintln!("{name} ideal nitsch: 180 deg {s180:?}\n  270 deg {s270:?}");
+        assert!(s270.recall >= s180.recall - 0.02, "{name}: recall 270 deg {} vs 180 deg {}", s270.recall, s180.recall);
+        assert!(s270.f1 >= s180.f1 - 0.02, "{name}: F1 270 deg {} vs 180 deg {}", s270.f1, s180.f1);
+    }
+}

@@ -10,11 +10,12 @@
 pub mod cluster;
 pub mod features;
 pub mod neighbours;
+pub mod row_order;
 
 use glam::Vec3;
 
-use crate::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_with};
 use crate::error::{ClassifyError, Result, check_cloud, is_valid};
+use crate::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_with};
 use crate::nitsch::features::{FeatureParams, Features, compute_features};
 use crate::nitsch::neighbours::{GridView, NeighbourParams, Wrap, detect_wrap};
 
@@ -33,6 +34,9 @@ pub struct NitschParams {
     pub clustering: ClusterParams,
     /// Largest distance at which an echo of plane > 0 takes a plane-0 decision, metres.
     pub echo_match_m: f32,
+    /// Flip the rows of columns that run down in elevation before the features
+    /// ([`row_order`]: the rear flanks of a nodding laser); ordinary rigs are unaffected.
+    pub fix_row_order: bool,
 }
 
 impl Default for NitschParams {
@@ -44,6 +48,7 @@ impl Default for NitschParams {
             features: FeatureParams::default(),
             clustering: ClusterParams::default(),
             echo_match_m: 0.5,
+            fix_row_order: true,
         }
     }
 }
@@ -79,12 +84,14 @@ pub struct StageTimes {
 pub struct Nitsch {
     /// Parameters.
     pub params: NitschParams,
-    /// Features of the last frame's plane 0.
+    /// Features of the last frame's plane 0 (in the reordered grid where [`row_order`] flipped columns).
     pub features: Features,
     /// Clusters of the last frame (diagnostics).
     pub workspace: ClusterWorkspace,
     candidate: Vec<bool>,
     plane0_ground: Vec<bool>,
+    /// Plane 0 with reversed columns flipped ([`row_order`]), and its decisions.
+    reordered: (Vec<Vec3>, Vec<f32>, Vec<bool>),
     /// Stage times of the last frame.
     pub times: StageTimes,
 }
@@ -133,18 +140,55 @@ impl Nitsch {
                 cloud.len()
             )));
         }
-        let view = self.view(cloud);
         let t0 = std::time::Instant::now();
-        compute_features(&view, &self.params.features, &mut self.features);
-        let t1 = std::time::Instant::now();
-        let n = view.rows * view.cols;
+        let reversed = if self.params.fix_row_order { row_order::reversed_columns(cloud) } else { None };
+        let n = cloud.rows * cloud.cols;
         self.plane0_ground.resize(n, false);
+        let t1 = match &reversed {
+            None => {
+                let view = self.view(cloud);
+                let mut ground = std::mem::take(&mut self.plane0_ground);
+                let t1 = self.decide_plane0(&view, &mut ground);
+                self.plane0_ground = ground;
+                t1
+            }
+            Some(rev) => {
+                let (mut points, mut ranges, mut ground) = std::mem::take(&mut self.reordered);
+                row_order::reorder_plane0(cloud, rev, &mut points, &mut ranges);
+                let mut view = self.view(cloud);
+                view.points = &points;
+                view.ranges = &ranges;
+                ground.resize(n, false);
+                let t1 = self.decide_plane0(&view, &mut ground);
+                for r in 0..cloud.rows {
+                    for c in 0..cloud.cols {
+                        let src = row_order::source_cell(rev, cloud.rows, cloud.cols, r, c);
+                        self.plane0_ground[src] = ground[r * cloud.cols + c];
+                    }
+                }
+                self.reordered = (points, ranges, ground);
+                t1
+            }
+        };
+        self.times = StageTimes { features_s: (t1 - t0).as_secs_f64(), clustering_s: t1.elapsed().as_secs_f64() };
+        out[..n].copy_from_slice(&self.plane0_ground);
+        echoes_from_plane0(cloud, &self.plane0_ground, self.params.echo_match_m, out);
+        Ok(())
+    }
+}
+
+impl Nitsch {
+    /// Features, candidates and (optionally) clustering on one plane-0 view, writing its decisions
+    /// into `ground`; returns when the features were done (stage times).
+    fn decide_plane0(&mut self, view: &GridView<'_>, ground: &mut [bool]) -> std::time::Instant {
+        compute_features(view, &self.params.features, &mut self.features);
+        let t1 = std::time::Instant::now();
         let thr = self.params.threshold;
         if self.params.cluster {
             self.candidate.clear();
             self.candidate.extend(self.features.g_rho.iter().map(|&g| g >= thr && g > 0.0));
             cluster_candidates_with(
-                &view,
+                view,
                 Some(self.features.valid()),
                 &self.candidate,
                 &self.features.normal,
@@ -152,16 +196,13 @@ impl Nitsch {
                 &mut self.workspace,
             );
             let returns = self.workspace.returns();
-            self.workspace.decide(view.points, returns, &self.params.clustering, &mut self.plane0_ground);
+            self.workspace.decide(view.points, returns, &self.params.clustering, ground);
         } else {
-            for (g, &q) in self.plane0_ground.iter_mut().zip(&self.features.g_rho) {
+            for (g, &q) in ground.iter_mut().zip(&self.features.g_rho) {
                 *g = q >= thr && q > 0.0;
             }
         }
-        self.times = StageTimes { features_s: (t1 - t0).as_secs_f64(), clustering_s: t1.elapsed().as_secs_f64() };
-        out[..n].copy_from_slice(&self.plane0_ground);
-        echoes_from_plane0(cloud, &self.plane0_ground, self.params.echo_match_m, out);
-        Ok(())
+        t1
     }
 }
 

@@ -7,6 +7,7 @@
 //! | `lux-roof-4` | 4 forward LUX on the roof front edge (x 1.6, z 1.6, y +0.45 / +0.15 / -0.15 / -0.45), pitched 0.8 / 4.0 / 7.2 / 10.4 deg down: the pitches differ by the LUX's 3.2 deg fan, so the 4 fans **stack** into one 16-layer fan with 0.8 deg between all neighbouring layers, from +0.4 down to -11.6 deg (the lowest layer reaches the ground at about 7.8 m). |
 //! | `lux-highway-7` | `lux-roof-4` plus 3 LUX on the rear bumper facing backwards (x -1.0, z 0.5, y +0.6 / 0 / -0.6, yaw 180), pitched 0.4 / 3.6 / 6.8 deg down: a second stacked 12-layer fan from +0.8 to -8.0 deg looking back; 28 layers in all. |
 //! | `utm30lx-nodding` | the nodding Hokuyo of seed 002, tilt axis at x 0, z 0.55 (the pattern's own frame is the tilt axis frame). |
+//! | `utm30lx-nodding-180` | the same with 180 deg of the 270 deg field of view (200 x 721), as seed 002's sparse scene used it. |
 //! | `vlp16-roof` | VLP-16 at x 1.3, z 1.85. |
 //! | `hdl64e-roof` | HDL-64E base at x 1.3, z 1.80 (its beams start 0.14-0.22 m higher). |
 //! | `os1-64-roof` | OS1-64 gen1, 1024 x 10 Hz, at x 1.3, z 1.85. |
@@ -26,6 +27,7 @@ pub const PRESETS: &[&str] = &[
     "lux-roof-4",
     "lux-highway-7",
     "utm30lx-nodding",
+    "utm30lx-nodding-180",
     "vlp16-roof",
     "hdl64e-roof",
     "os1-64-roof",
@@ -72,6 +74,13 @@ pub fn preset(name: &str) -> Result<Rig> {
             Ok(s)
         }
         "utm30lx-nodding" => Ok(vec![sensor("nodder", "utm30lx-nodding", at(0.0, 0.0, 0.55, 0.0, 0.0))?]),
+        "utm30lx-nodding-180" => {
+            let mut s = sensor("nodder", "utm30lx-nodding", at(0.0, 0.0, 0.55, 0.0, 0.0))?;
+            if let SensorSpec::Utm30lxNodding(spec) = &mut s.spec {
+                spec.fov_deg = 180.0;
+            }
+            Ok(vec![s])
+        }
         "vlp16-roof" => roof("vlp16", 1.85),
         "hdl64e-roof" => roof("hdl64e", 1.80),
         "os1-64-roof" => roof("os1-64", 1.85),
