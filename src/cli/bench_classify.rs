@@ -12,7 +12,7 @@
 use std::time::Instant;
 
 use anyhow::Context;
-use classifier::{FrameInput, method_by_name};
+use classifier::FrameInput;
 use sim::scan::ScanConfig;
 
 /// Arguments of `groundtruth bench classify`.
@@ -40,6 +40,13 @@ pub struct Args {
     /// Time real files instead of a scan: a `.pcd` / `.bin` file or a directory of them.
     #[arg(long)]
     input: Option<std::path::PathBuf>,
+    /// Trained model file for `mcdaniel` (default: the bundled forest model).
+    #[arg(long)]
+    model: Option<std::path::PathBuf>,
+    /// Worker threads of methods that run stages in parallel (`mcdaniel`; 0 = all cores). Nitsch,
+    /// RANSAC and grid run on one thread whatever this says.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
 }
 
 fn stats(v: &[f64]) -> serde_json::Value {
@@ -78,7 +85,7 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
         Some(args.rig.as_str())
     };
     let repeats = args.repeats.max(1);
-    let mut method = method_by_name(&args.method, args.seed)?;
+    let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut per_file = Vec::new();
     for (index, path) in files.iter().enumerate() {
@@ -137,17 +144,25 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
 
 /// Runs the classification benchmark and prints one JSON object.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads).build().context("starting the thread pool")?;
+    pool.install(|| run_in_pool(&args))
+}
+
+/// The benchmark inside the thread pool of `--threads`.
+fn run_in_pool(args: &Args) -> anyhow::Result<()> {
     if let Some(input) = &args.input {
-        return run_files(&args, input);
+        return run_files(args, input);
     }
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;
     let config =
         ScanConfig { seed: args.seed, frames: args.frames, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
     let frames = sim::scan::scan(&scene.mesh, &rig, &config).context("scanning")?;
-    let mut method = method_by_name(&args.method, args.seed)?;
+    let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let repeats = args.repeats.max(1);
-    let (mut feat, mut clus, mut total) = (Vec::new(), Vec::new(), Vec::new());
+    let mut total = Vec::new();
+    // Stage name -> milliseconds per classification, in pipeline order.
+    let mut stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
     for f in &frames {
         for _ in 0..repeats {
             let input = FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };
@@ -155,14 +170,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let out = method.classify(&input)?;
             total.push(t.elapsed().as_secs_f64() * 1e3);
             std::hint::black_box(out);
-            if let Some(s) = method.stage_times() {
-                feat.push(s.features_s * 1e3);
-                clus.push(s.clustering_s * 1e3);
+            for (name, s) in method.named_stage_times() {
+                match stages.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, v)) => v.push(s * 1e3),
+                    None => stages.push((name, vec![s * 1e3])),
+                }
             }
         }
     }
     let first = &frames[0].cloud;
-    let out = serde_json::json!({
+    let mut out = serde_json::json!({
         "method": args.method,
         "scene": args.scene,
         "rig": args.rig,
@@ -172,11 +189,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "cols": first.cols,
         "planes": first.planes,
         "returns": first.returns(),
-        "threads": 1,
-        "features_ms": stats(&feat),
-        "clustering_ms": stats(&clus),
+        "threads": if method.named_stage_times().len() > 2 { rayon::current_num_threads() } else { 1 },
         "total_ms": stats(&total),
     });
+    for (name, v) in &stages {
+        out[format!("{name}_ms")] = stats(v);
+    }
     println!("{}", serde_json::to_string_pretty(&out)?);
     Ok(())
 }

@@ -74,3 +74,20 @@ pub fn scan_standing(
     let config = sim::scan::ScanConfig { seed, frames, ideal, ego_z_m: loaded.ego_ground_z_m, ..Default::default() };
     sim::scan::scan(&loaded.mesh, &rig, &config).with_context(|| format!("scanning `{scene}`"))
 }
+
+/// The classification method `name` (see `groundtruth list`) with its default parameters; `model`
+/// is a trained model file for `mcdaniel` (default: the bundled forest model). `seed` seeds RANSAC.
+pub fn method(
+    name: &str,
+    seed: u64,
+    model: Option<&std::path::Path>,
+) -> anyhow::Result<Box<dyn classifier::GroundClassifier + Send>> {
+    match model {
+        None => Ok(classifier::method_by_name(name, seed)?),
+        Some(path) if name == "mcdaniel" => {
+            let model = classifier::McDanielModel::load(path)?;
+            Ok(classifier::mcdaniel_with_model(model, classifier::McDanielParams::default())?)
+        }
+        Some(path) => anyhow::bail!("--model `{}` applies to `mcdaniel` only, not to `{name}`", path.display()),
+    }
+}

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use classifier::metrics::range_band_name;
-use classifier::{Evaluation, FrameInput, Scores, method_by_name};
+use classifier::{Evaluation, FrameInput, Scores};
 use sim::scan::ScanConfig;
 
 /// Arguments of `groundtruth eval`.
@@ -53,6 +53,9 @@ pub struct Args {
     /// Also print per-frame means and the breakdown by class and range band.
     #[arg(long)]
     details: bool,
+    /// Trained model file for `mcdaniel` (`groundtruth train`; default: the bundled forest model).
+    #[arg(long, conflicts_with = "paper")]
+    model: Option<PathBuf>,
 }
 
 /// Runs `groundtruth eval`.
@@ -78,7 +81,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     // Refuse unknown names before scanning.
     for n in &names {
-        method_by_name(n, args.seed)?;
+        super::common::method(n, args.seed, args.model.as_deref().filter(|_| n == "mcdaniel"))?;
     }
     let scene = super::common::load_scene_full(scene_name, args.seed)?;
     let rig = super::common::load_rig(rig_name)?;
@@ -95,7 +98,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     println!("{:<24} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}", "method", "acc", "FPR", "precision", "recall", "F1", "IoU");
     let mut json: BTreeMap<String, Scores> = BTreeMap::new();
     for name in &names {
-        let mut method = method_by_name(name, args.seed)?;
+        let mut method = super::common::method(name, args.seed, args.model.as_deref().filter(|_| name == "mcdaniel"))?;
         let mut eval = Evaluation::default();
         for f in &frames {
             let input = FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };
