@@ -27,6 +27,10 @@ fn main() {
     let nodding_180 = concat!(env!("CARGO_MANIFEST_DIR"), "/../sim/rigs/nodding-180.toml");
     let scenes =
         [("forest-sparse", nodding_180), ("forest-moderate", "utm30lx-nodding"), ("forest-dense", "utm30lx-nodding")];
+    let max_iter: usize =
+        args.iter().position(|a| a == "--max-iter").and_then(|i| args.get(i + 1)).map_or(100_000, |s| s.parse().expect("--max-iter N"));
+    let eps: f64 = args.iter().position(|a| a == "--eps").and_then(|i| args.get(i + 1)).map_or(0.01, |s| s.parse().expect("--eps X"));
+    let train_params = TrainParams { svm: mcdaniel::SvmParams { max_iter, eps, ..Default::default() }, ..Default::default() };
     let params = FeatureParams::default();
     let mut clouds = Vec::new();
     let mut sets: Vec<CandidateSet> = Vec::new();
@@ -51,8 +55,9 @@ fn main() {
     for test in 0..3 {
         let train_sets: Vec<CandidateSet> = (0..3).filter(|&k| k != test).map(|k| sets[k].clone()).collect();
         let t = Instant::now();
-        let model = mcdaniel::train(&train_sets, &TrainParams::default()).expect("train");
+        let (model, report) = mcdaniel::train_with_report(&train_sets, &train_params).expect("train");
         let train_s = t.elapsed().as_secs_f64();
+        println!("  solver: {report:?}");
         let set = &sets[test];
         let scores = mcdaniel::decision_values(&model, set);
         println!(
@@ -68,6 +73,13 @@ fn main() {
             println!("  {:<8} {:>8} {:>8} {:>8}", class.name(), idx.len(), called, idx.len() - called);
         }
         let curve = mcdaniel::roc_curve(&scores, &set.ground).expect("roc");
+        if args.iter().any(|a| a == "--debug") {
+            let mut neg: Vec<usize> = (0..set.len()).filter(|&k| !set.ground[k]).collect();
+            neg.sort_by(|&a, &b| scores[b].total_cmp(&scores[a]));
+            for &k in neg.iter().take(6) {
+                println!("  top negative {:?} score {:.3} at {} f {:?}", set.class[k], scores[k], set.point_in_vehicle[k], set.features[k]);
+            }
+        }
         println!(
             "  accuracy {:.4}  AUC {:.4}  TPR at FPR < 0.5 % {:.3}  at FPR < 7 % {:.3}  at FPR < 10 % {:.3}",
             correct as f64 / set.len() as f64,
@@ -84,7 +96,7 @@ fn main() {
         println!("  whole cloud: {:?}", eval.pooled.scores());
     }
     // Stage times on forest-dense (utm30lx-nodding, 200 x 1081), best of 10.
-    let model = mcdaniel::train(&sets, &TrainParams::default()).expect("train");
+    let model = mcdaniel::train(&sets, &train_params).expect("train");
     let mut m = mcdaniel::McDaniel::new(model.clone(), Default::default()).expect("model");
     let mut best = McDanielTimes { origins_s: f64::MAX, ..Default::default() };
     let mut best_total = f64::MAX;

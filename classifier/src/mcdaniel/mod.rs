@@ -292,6 +292,12 @@ impl Default for TrainParams {
 /// standardised by the training set's mean and standard deviation (0 -> 1), then the linear SVM.
 /// Errors ([`ClassifyError::TrainingSet`]) when there are no ground or no non-ground candidates.
 pub fn train(sets: &[CandidateSet], params: &TrainParams) -> Result<McDanielModel> {
+    train_with_report(sets, params).map(|(model, _)| model)
+}
+
+/// [`train`], also returning the solver's outer iterations and whether it reached its tolerance
+/// (false: it stopped at [`SvmParams::max_iter`]).
+pub fn train_with_report(sets: &[CandidateSet], params: &TrainParams) -> Result<(McDanielModel, SolverReport)> {
     let Some(first) = sets.first() else {
         return Err(ClassifyError::TrainingSet { ground: 0, non_ground: 0 });
     };
@@ -343,13 +349,26 @@ pub fn train(sets: &[CandidateSet], params: &TrainParams) -> Result<McDanielMode
         feature_params: first.feature_params.clone(),
         mean: mean.to_vec(),
         std,
-        weights: svm.weights,
+        weights: svm.weights.clone(),
         bias: svm.bias,
         c: params.svm.c,
         trained_on: params.trained_on.clone(),
     };
     model.check("<trained>").map_err(ClassifyError::Model)?;
-    Ok(model)
+    Ok((model, SolverReport { iterations: svm.iterations, converged: svm.converged, candidates: n, ground: positives }))
+}
+
+/// How training went.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct SolverReport {
+    /// Outer iterations (passes) of the dual coordinate descent.
+    pub iterations: usize,
+    /// Whether the stopping tolerance was reached.
+    pub converged: bool,
+    /// Training candidates.
+    pub candidates: usize,
+    /// Of which ground.
+    pub ground: usize,
 }
 
 /// Classification parameters besides the model.
