@@ -133,7 +133,13 @@ fn kitti_round_trip_in_sensor_frame_with_calibration() {
     let files = write_frame(dir.path(), &cloud, &ctx, &formats).unwrap();
     let names: Vec<&str> = files.iter().map(|f| f.file.as_str()).collect();
     assert_eq!(names, ["frame_000007.bin", "frame_000007.label", "frame_000007.calib.txt"]);
-    let idx = returns(&cloud);
+    // The file holds the returns in scan order: top row first, each row from the front column
+    // (cols / 2) counter-clockwise (down the columns, wrapping).
+    let idx = kitti::scan_order(&cloud);
+    let mut sorted = idx.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, returns(&cloud));
+    assert!(idx.windows(2).all(|w| w[0] / cloud.cols >= w[1] / cloud.cols), "rows go down");
     assert_eq!(files[0].points, idx.len());
     assert_eq!(files[1].points, idx.len());
     let bin = dir.path().join("frame_000007.bin");

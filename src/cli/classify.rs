@@ -3,8 +3,14 @@
 //! frame, plus an outcome picture where the input carries labels.
 //!
 //! Output per frame, in `--out`: `frame_NNNNNN.ground`, one byte per point in the input's point
-//! order, 1 = ground, 0 = not. For an organized PCD that is every cell of the grid in grid order
-//! (all echo planes), no-return cells included (always 0). For a KITTI `.bin` it is every point of
+//! order, 1 = ground, 0 = not. For an organized PCD that is every cell of the grid in the file's
+//! order (all echo planes), no-return cells included (always 0). An organized PCD of another tool
+//! (no `# groundtruth` line: a ROS driver's, top-first or bottom-first, with or without `ring`, NaN
+//! or zero no-returns) keeps its cells and has its rows put in elevation order first
+//! ([`classifier::ordering::organized`]); a file whose way up cannot be told is refused. An
+//! unorganized PCD is ordered as a KITTI file is. Such files hold sensor-frame points (as the drivers
+//! write them): `--rig` gives the mount that takes them to the vehicle frame (else they stay as
+//! they are). For a KITTI `.bin` it is every point of
 //! the file in file order; the points are first put into ring x column order ([`classifier::ordering`]):
 //! by scan unfolding where the file is in scan order (as KITTI's and ours are), else from the beam
 //! table of `--rig` (a single-sensor rig, with its origin offsets; default: the HDL-64E nominal
@@ -20,10 +26,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use classifier::FrameInput;
 use classifier::ordering::{
     BeamTable, OrderingReport, PathChoice, PointAttributes, UnfoldParams, decisions_per_point, order_cloud,
+    order_organized,
 };
-use classifier::FrameInput;
 use glam::{Affine3A, Mat4};
 use sim::OrderedCloud;
 
@@ -134,8 +141,37 @@ pub(crate) fn read_frame_timed(path: &Path, rig: Option<&str>) -> anyhow::Result
     let t0 = std::time::Instant::now();
     match path.extension().and_then(|e| e.to_str()) {
         Some("pcd") => {
-            let cloud = sim::io::pcd::read(path)?;
-            Ok((ReadFrame { cloud, report: None }, t0.elapsed().as_secs_f64() * 1e3))
+            let (cloud, info) = sim::io::pcd::read_with_info(path)?;
+            let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+            if info.ours || cloud.planes > 1 {
+                return Ok((ReadFrame { cloud, report: None }, read_ms));
+            }
+            if info.organized {
+                let vehicle_from_sensor = match rig {
+                    Some(r) => rig_table(r)?.1,
+                    None => Affine3A::IDENTITY,
+                };
+                let (cloud, report) = order_organized(&cloud, info.has_ring, vehicle_from_sensor)
+                    .with_context(|| format!("ordering the rows of `{}`", path.display()))?;
+                return Ok((ReadFrame { cloud, report: Some(report) }, read_ms));
+            }
+            // An unorganized PCD: ordered as a KITTI file is.
+            let labels = cloud.label.iter().any(|l| l.0 != 0).then_some(cloud.label.as_slice());
+            let (table, vehicle_from_sensor) = match rig {
+                Some(r) => rig_table(r)?,
+                None => (BeamTable::hdl64e(KITTI_COLUMNS), Affine3A::IDENTITY),
+            };
+            let attributes = PointAttributes { intensity: Some(&cloud.intensity), labels, time_s: Some(&cloud.time_s) };
+            let (ordered, report) = order_cloud(
+                &cloud.point_in_vehicle,
+                &attributes,
+                &table,
+                vehicle_from_sensor,
+                PathChoice::Auto,
+                &UnfoldParams::default(),
+            )
+            .with_context(|| format!("ordering `{}`", path.display()))?;
+            Ok((ReadFrame { cloud: ordered, report: Some(report) }, read_ms))
         }
         Some("bin") => {
             let label = path.with_extension("label");

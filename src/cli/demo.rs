@@ -50,6 +50,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         yaw_rate: 0.0,
         ideal: false,
         format: "pcd,ply,kitti,las".into(),
+        pcd_layout: "groundtruth".into(),
         threads: None,
         backend: "bvh".into(),
     };

@@ -38,6 +38,13 @@ pub struct Args {
     /// Files to write per frame: any of pcd, pcd-ascii, ply, kitti, las (comma-separated).
     #[arg(long, default_value = "pcd")]
     pub format: String,
+    /// Layout of the organized PCD: `groundtruth` (ours: rows bottom-first, every field, NaN
+    /// no-returns), `velodyne` (velodyne_pointcloud's organized PointXYZIRT: ring 0 = bottom, NaN
+    /// no-returns) or `ouster` (ouster-ros: row 0 = ring 0 = the top beam, zero no-returns, `range`
+    /// in millimetres). The driver layouts hold sensor-frame points for a single-sensor rig, plane 0
+    /// only, plus our `label` field; the manifest's `pcd_layout` says which was written.
+    #[arg(long, default_value = "groundtruth")]
+    pub pcd_layout: String,
     /// Worker threads (default: all cores). Results are identical at any count.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -86,7 +93,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Scans as `args` says, writes every frame's files and the manifest into `args.out`, and returns the manifest.
 pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
-    let formats = Formats::parse(&args.format)?;
+    let mut formats = Formats::parse(&args.format)?;
+    formats.pcd_layout = sim::io::pcd::PcdLayout::parse(&args.pcd_layout)?;
     let backend = parse_backend(&args.backend)?;
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;
@@ -154,6 +162,7 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         yaw_rate_rad_per_s: args.yaw_rate,
         frame_period_s: scanner.frame_period_s(),
         kitti_frame: if single { "sensor" } else { "vehicle" }.to_string(),
+        pcd_layout: formats.pcd_layout.name().to_string(),
         planes: scanner.planes(),
         ordering: sim::layout::ORDERING.to_string(),
         sensors,

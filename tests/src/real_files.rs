@@ -95,3 +95,88 @@ pub fn compare_bin(
         points: n,
     }
 }
+
+/// Per layout variant: its name, the returns compared and how many decisions differ from the
+/// organized bottom-first file's (our layout) on the same points.
+#[derive(Clone, Debug)]
+pub struct LayoutAgreement {
+    /// The variant.
+    pub layout: String,
+    /// Returns compared.
+    pub returns: usize,
+    /// Returns whose decision differs from our layout's.
+    pub differing: usize,
+    /// The ordering report's one-line summary.
+    pub summary: String,
+}
+
+/// Scans frame 0 of `scene` with `rig` (single-sensor) and writes it as every organized layout
+/// (ours; velodyne and ouster in the sensor frame, as the drivers write them; each also read as if
+/// it had no `ring` field) and as a `.bin` in scan
+/// order and shuffled; each is read back, ordered and classified with `method`, and its decisions
+/// per point compared with our organized bottom-first file's.
+pub fn layout_agreement(scene: &str, rig: &str, seed: u64, method: &str) -> Vec<LayoutAgreement> {
+    use classifier::ordering::{decisions_per_point, order_organized};
+    use sim::io::pcd::{PcdLayout, encode_layout, read_bytes_with_info};
+    let loaded = scenes::load(scene, seed).expect("bundled scene");
+    let rig_v = sim::Rig::preset(rig).expect("rig preset");
+    let config = ScanConfig { seed, frames: 1, ego_z_m: loaded.ego_ground_z_m, ..ScanConfig::default() };
+    let frames = scan(&loaded.mesh, &rig_v, &config).expect("scan");
+    let cloud = &frames[0].cloud;
+    let (rows, cols) = (cloud.rows, cloud.cols);
+    let classify = |c: &sim::OrderedCloud| {
+        let mut m = method_by_name(method, 0).expect("method");
+        m.classify(&classifier::FrameInput { index: 0, cloud: c, world_from_vehicle: None }).expect("classify")
+    };
+    let path = std::path::Path::new("frame.pcd");
+    let vehicle_from_sensor = rig_v.sensors[0].mount.vehicle_from_sensor();
+    let sensor_from_vehicle = vehicle_from_sensor.inverse();
+    let ours =
+        read_bytes_with_info(path, &encode_layout(cloud, PcdLayout::Groundtruth, false, None).unwrap()).unwrap().0;
+    let reference = classify(&ours);
+    let mut out = Vec::new();
+    for layout in [PcdLayout::Groundtruth, PcdLayout::Velodyne, PcdLayout::Ouster] {
+        let bytes = encode_layout(cloud, layout, false, Some(&sensor_from_vehicle)).expect("encode");
+        let (read, info) = read_bytes_with_info(path, &bytes).expect("read");
+        for with_ring in [true, false] {
+            if layout == PcdLayout::Groundtruth && !with_ring {
+                continue;
+            }
+            // Our file is taken as it is; the drivers' are reordered as a real file would be.
+            let (decisions, summary) = if info.ours {
+                let d = classify(&read);
+                (d.iter().map(|&g| u8::from(g)).collect::<Vec<u8>>(), "ours: as written".to_string())
+            } else {
+                let (ordered, report) =
+                    order_organized(&read, info.has_ring && with_ring, vehicle_from_sensor).expect("order organized");
+                (decisions_per_point(&report, &classify(&ordered)), report.summary())
+            };
+            // File cell -> grid cell of the scan.
+            let grid_cell = |i: usize| {
+                let (k, c) = (i / cols, i % cols);
+                if layout == PcdLayout::Ouster { (rows - 1 - k) * cols + c } else { i }
+            };
+            let (mut returns, mut differing) = (0, 0);
+            for (i, &d) in decisions.iter().enumerate().take(rows * cols) {
+                let g = grid_cell(i);
+                if cloud.has_return(g) {
+                    returns += 1;
+                    differing += usize::from((d == 1) != reference[g]);
+                }
+            }
+            let name = format!("{}{}", layout.name(), if with_ring { "" } else { " without ring" });
+            out.push(LayoutAgreement { layout: name, returns, differing, summary });
+        }
+    }
+    for shuffle in [false, true] {
+        let c = compare_bin(scene, rig, seed, method, shuffle, PathChoice::Auto);
+        let differing = ((1.0 - c.same_decision) * c.points as f64).round() as usize;
+        out.push(LayoutAgreement {
+            layout: if shuffle { "bin shuffled".into() } else { "bin scan order".into() },
+            returns: c.points,
+            differing,
+            summary: c.report.summary(),
+        });
+    }
+    out
+}

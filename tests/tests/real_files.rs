@@ -27,3 +27,20 @@ fn shuffled_bin_falls_back_to_the_beam_table() {
     assert!(c.true_cell >= 0.97, "{:.4} in their true cell", c.true_cell);
     assert!((c.f1_bin - c.f1_grid).abs() <= 0.005, "F1 {:.4} vs {:.4}", c.f1_bin, c.f1_grid);
 }
+
+#[test]
+fn every_layout_gives_the_decisions_of_the_organized_bottom_first_file() {
+    for a in gt_tests::real_files::layout_agreement("city", "os1-64-roof", 90210, "nitsch") {
+        assert!(a.returns > 10_000, "{}: {} returns", a.layout, a.returns);
+        // The ouster layout stores ranges in whole millimetres; the rest is the same points.
+        let allowed = if a.layout.starts_with("ouster") { a.returns / 1000 } else { 0 };
+        assert!(
+            a.differing <= allowed,
+            "{}: {} of {} decisions differ ({})",
+            a.layout,
+            a.differing,
+            a.returns,
+            a.summary
+        );
+    }
+}

@@ -200,13 +200,16 @@ impl TableRows {
         let d2 = p.x * p.x + p.y * p.y;
         let n = self.len();
         let tan = &self.tan_elevation;
-        let t0 = (p.z - self.mean_vertical_m) / d2.sqrt().max(1e-6);
+        let inv_d = 1.0 / d2.sqrt().max(1e-6);
+        let t0 = (p.z - self.mean_vertical_m) * inv_d;
         let guess = tan.partition_point(|&x| x < t0).min(n - 1);
+        // 1 / sqrt(d^2 - h^2) = (1 / d) (1 + h^2 / (2 d^2)) to well within 1e-6 for h << d.
+        let inv_d2 = inv_d * inv_d;
         let fine = |r: usize| {
             let h = self.horizontal_m[r];
-            (p.z - self.vertical_m[r]) / (d2 - h * h).max(1e-12).sqrt()
+            (p.z - self.vertical_m[r]) * inv_d * (1.0 + 0.5 * h * h * inv_d2)
         };
-        let (lo, hi) = (guess.saturating_sub(3), (guess + 3).min(n - 1));
+        let (lo, hi) = (guess.saturating_sub(2), (guess + 2).min(n - 1));
         let mut best = (f32::INFINITY, guess, t0);
         for (r, &tan_r) in tan.iter().enumerate().take(hi + 1).skip(lo) {
             let f = fine(r);
@@ -237,7 +240,7 @@ impl TableRows {
     /// table); column = the nearest integer.
     pub fn column_steps(&self, az: f32) -> f32 {
         let steps = (self.azimuth_left_rad - az) / self.azimuth_step_rad;
-        if self.full_turn { steps.rem_euclid(std::f32::consts::TAU / self.azimuth_step_rad) } else { steps }
+        if self.full_turn { wrap_into(steps, std::f32::consts::TAU / self.azimuth_step_rad) } else { steps }
     }
 }
 
@@ -265,4 +268,22 @@ pub fn fast_atan2(y: f32, x: f32) -> f32 {
         a = PI - a;
     }
     if y < 0.0 { -a } else { a }
+}
+
+/// `x` wrapped into `[0, period)` for `x` within a few periods of it (no `fmod`).
+#[inline]
+pub fn wrap_into(mut x: f32, period: f32) -> f32 {
+    if !(x.is_finite() && period > 0.0) {
+        return x;
+    }
+    if x.abs() > 8.0 * period {
+        return x.rem_euclid(period);
+    }
+    while x < 0.0 {
+        x += period;
+    }
+    while x >= period {
+        x -= period;
+    }
+    x
 }

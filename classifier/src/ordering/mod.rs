@@ -8,6 +8,8 @@
 //! - **the beam table** ([`table`]) for clouds out of order: each point's row from its elevation,
 //!   with the table's origin offsets undone ([`beam_table`]); taken when unfolding is refused, and
 //!   the report says why;
+//! - **organized clouds** ([`organized`]) keep their cells; their rows are put in elevation order
+//!   from the `ring` field or the rows' elevations, whichever way up the file stores them;
 //!
 //! Columns come from each point's beam azimuth on every path. Points that share a cell are all kept
 //! ([`placement`]): the adjacent free column on the point's side, else a further plane of the same
@@ -17,6 +19,7 @@
 //! placed.
 
 pub mod beam_table;
+pub mod organized;
 pub mod placement;
 pub mod report;
 pub mod table;
@@ -26,6 +29,7 @@ use glam::{Affine3A, Vec3};
 use sim::{OrderedCloud, SemanticClass};
 
 pub use beam_table::{BeamTable, TableRows};
+pub use organized::order_organized;
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};
 pub use unfold::UnfoldParams;

@@ -135,10 +135,13 @@ pub(crate) fn build_cloud(
     report: &mut OrderingReport,
 ) -> OrderedCloud {
     let mut cloud = OrderedCloud::empty(rows, cols, planes);
-    for (i, (r, c)) in cloud.ring.iter_mut().zip(cloud.column.iter_mut()).enumerate() {
-        let cell = i % (rows * cols);
-        *r = (cell / cols) as u16;
-        *c = (cell % cols) as u32;
+    for (ring_index, (ring, column)) in
+        cloud.ring.chunks_exact_mut(cols).zip(cloud.column.chunks_exact_mut(cols)).enumerate()
+    {
+        ring.fill((ring_index % rows.max(1)) as u16);
+        for (c, v) in column.iter_mut().enumerate() {
+            *v = c as u32;
+        }
     }
     let identity = vehicle_from_sensor == Affine3A::IDENTITY;
     for (wish, &cell) in wishes.iter().zip(cell_of_wish) {

@@ -8,7 +8,9 @@
 //! from the summed azimuth steps). Within a ring the progress grows; a ring ends where it drops.
 //! The jump of the azimuth from +pi to -pi at the back is no drop (progress is continuous there),
 //! so the few extra wraps of points jittering about +-pi start no ring. A drop larger than
-//! `backward_step_rad` outside the cut window is a boundary (a laser with no returns near the cut);
+//! `backward_step_rad` (plus `parallax_m / d` for points at horizontal distance `d`: off-axis beam
+//! origins step back on the vehicle's own body) outside the cut window is a boundary (a laser with
+//! no returns near the cut);
 //! inside the window (`cut_window_rad` either side of the cut, where one laser's last points and
 //! the next one's first points mix) a run of points that contains a drop holds one boundary, put at
 //! the largest elevation step in the direction the rings go (the elevation seen from the origin of
@@ -24,7 +26,7 @@
 
 use glam::Vec3;
 
-use super::beam_table::{TableRows, fast_atan2};
+use super::beam_table::{TableRows, fast_atan2, wrap_into};
 use super::placement::Wish;
 use super::report::OrderingReport;
 
@@ -39,6 +41,10 @@ pub struct UnfoldParams {
     /// A drop of progress larger than this outside the cut window is a ring boundary, radians
     /// (default 2 degrees: origin parallax moves a laser's own points back by less).
     pub backward_step_rad: f32,
+    /// Points this close (horizontal distance `d`) may step back by a further `parallax_m / d`
+    /// radians inside their own ring (beam origins off the axis, the vehicle's own body close by),
+    /// metres (default 0.15).
+    pub parallax_m: f32,
     /// Largest elevation error of a ring's median against its matched row, as a multiple of the
     /// table's largest beam gap (default 4).
     pub max_median_error_gaps: f32,
@@ -50,6 +56,7 @@ impl Default for UnfoldParams {
             cut_azimuth_rad: 0.0,
             cut_window_rad: 4f32.to_radians(),
             backward_step_rad: 2f32.to_radians(),
+            parallax_m: 0.15,
             max_median_error_gaps: 4.0,
         }
     }
@@ -76,13 +83,14 @@ fn median(v: &mut [f32]) -> f32 {
 
 /// Splits the usable points (file order; `az` their azimuths, `fine` their `tan(elevation)` from
 /// their nearest beam's origin) into rings; returns the start of each ring, or why the order does
-/// not unfold.
+/// not unfold, with the direction of the turn (+1 counter-clockwise).
 pub(crate) fn ring_starts(
     az: &[f32],
+    dist: &[f32],
     fine: &[f32],
     rows: &TableRows,
     params: &UnfoldParams,
-) -> Result<Vec<usize>, String> {
+) -> Result<(Vec<usize>, f32), String> {
     use std::f32::consts::{PI, TAU};
     let n = az.len();
     if n < 2 {
@@ -94,7 +102,7 @@ pub(crate) fn ring_starts(
     if turns > rows.len() as f32 + 1.0 {
         return Err(format!("the azimuth turns {turns:.0} times, more than the table's {} rows", rows.len()));
     }
-    let q: Vec<f32> = az.iter().map(|&a| (dir * (a - params.cut_azimuth_rad)).rem_euclid(TAU)).collect();
+    let q: Vec<f32> = az.iter().map(|&a| wrap_into(dir * (a - params.cut_azimuth_rad), TAU)).collect();
     let w = params.cut_window_rad;
     let in_window = |j: usize| q[j] < w || q[j] > TAU - w;
     // Which way the rings go in elevation: compare the first and last 1/8 of the points.
@@ -103,7 +111,9 @@ pub(crate) fn ring_starts(
     let mut tail: Vec<f32> = fine[n - m..].to_vec();
     let down = median(&mut head) >= median(&mut tail);
     let min_gap = rows.tan_elevation.windows(2).map(|w| w[1] - w[0]).fold(f32::INFINITY, f32::min);
-    let drop = |a: usize, b: usize| q[b] < q[a] - params.backward_step_rad;
+    let drop = |a: usize, b: usize| {
+        q[b] < q[a] - params.backward_step_rad - params.parallax_m / dist[a].min(dist[b]).max(1e-3)
+    };
     let mut starts = vec![0usize];
     // The file's first points are the first ring's, window or not.
     let mut j = 1;
@@ -177,7 +187,7 @@ pub(crate) fn ring_starts(
     if starts.len() < 2 {
         return Err("fewer than 2 rings".into());
     }
-    Ok(starts)
+    Ok((starts, dir))
 }
 
 /// Matches rings (in file order) to table rows by their median `tan(elevation)`: a monotone alignment
@@ -247,12 +257,17 @@ pub(crate) fn unfold_wishes(
 ) -> Result<Vec<Wish>, String> {
     let mut az = Vec::with_capacity(valid.len());
     let mut fine = Vec::with_capacity(valid.len());
+    let mut dist = Vec::with_capacity(valid.len());
+    let offsets = rows.horizontal_m.iter().chain(&rows.vertical_m).any(|&x| x != 0.0);
     for &k in valid {
         let p = points[k as usize];
         az.push(fast_atan2(p.y, p.x));
-        fine.push(rows.nearest_row(p).1);
+        let d = (p.x * p.x + p.y * p.y).sqrt();
+        // Without origin offsets the elevation seen from the sensor origin is exact enough.
+        fine.push(if offsets { rows.nearest_row(p).1 } else { p.z / d.max(1e-6) });
+        dist.push(d);
     }
-    let starts = ring_starts(&az, &fine, rows, params)?;
+    let (starts, dir) = ring_starts(&az, &dist, &fine, rows, params)?;
     let mut bounds = starts.clone();
     bounds.push(valid.len());
     let medians: Vec<f32> = bounds.windows(2).map(|w| median(&mut fine[w[0]..w[1]].to_vec())).collect();
@@ -261,6 +276,12 @@ pub(crate) fn unfold_wishes(
     let mut wishes = Vec::with_capacity(valid.len());
     for (ring, w) in bounds.windows(2).enumerate() {
         let row = row_of_ring[ring];
+        // Columns from azimuth, unwrapped along the ring and kept strictly moving in the scan
+        // direction (a counter-clockwise turn goes down the columns): a point whose column is
+        // taken by its predecessor takes the next one, the nearest free cell in scan order.
+        let cols = rows.cols as f32;
+        let col_dir = if rows.full_turn { -dir } else { 0.0 };
+        let (mut prev_steps, mut unwrapped, mut last) = (f32::NAN, 0.0f32, f32::NAN);
         for (&k, &a) in valid[w[0]..w[1]].iter().zip(&az[w[0]..w[1]]) {
             let p = points[k as usize];
             let h = rows.horizontal_m[row];
@@ -270,7 +291,29 @@ pub(crate) fn unfold_wishes(
                 let d = (p.x * p.x + p.y * p.y).sqrt().max(h.abs() * 1.0001);
                 a - (h / d).asin()
             };
-            wishes.push(Wish { point: k, row: row as u32, steps: rows.column_steps(beam) });
+            let steps = rows.column_steps(beam);
+            if col_dir == 0.0 {
+                wishes.push(Wish { point: k, row: row as u32, steps });
+                continue;
+            }
+            if prev_steps.is_nan() {
+                unwrapped = steps;
+            } else {
+                let mut d = steps - prev_steps;
+                if d >= 0.5 * cols {
+                    d -= cols;
+                } else if d < -0.5 * cols {
+                    d += cols;
+                }
+                unwrapped += d;
+            }
+            prev_steps = steps;
+            let mut c = unwrapped.round();
+            if !last.is_nan() && (c - last) * col_dir < 1.0 {
+                c = last + col_dir;
+            }
+            last = c;
+            wishes.push(Wish { point: k, row: row as u32, steps: wrap_into(c, cols) });
         }
     }
     Ok(wishes)

@@ -2,6 +2,9 @@
 //! (PCD, PLY, KITTI, LAS; see [`super::pcd`], [`super::ply`], [`super::kitti`], [`super::las`]),
 //! each file atomically, and lists the files written with their point counts.
 //!
+//! The PCD is our organized layout unless [`Formats::pcd_layout`] names a ROS driver's (velodyne,
+//! ouster: sensor-frame points for a single-sensor rig, see [`super::pcd::PcdLayout`]).
+//!
 //! File names per frame `k` (stem `frame_{k:06}`): `.pcd`, `.ply`, `.bin` + `.label` (+
 //! `.calib.txt` when the KITTI points are in the sensor frame), `.las`, `.laz`. The formats are encoded
 //! in parallel (rayon); the bytes do not depend on the thread count.
@@ -29,6 +32,8 @@ pub struct Formats {
     pub las: bool,
     /// LAZ (compressed LAS 1.4, same content; needs the `laz` cargo feature).
     pub laz: bool,
+    /// Layout of the organized PCD: ours (default) or a ROS driver's ([`super::pcd::PcdLayout`]).
+    pub pcd_layout: super::pcd::PcdLayout,
 }
 
 impl Formats {
@@ -109,9 +114,21 @@ fn written(file: String, format: &str, points: usize) -> WrittenFile {
     WrittenFile { file, format: format.to_string(), points }
 }
 
-fn write_pcd(dir: &Path, stem: &str, cloud: &OrderedCloud, ascii: bool) -> Result<Vec<WrittenFile>> {
+fn write_pcd(
+    dir: &Path,
+    stem: &str,
+    cloud: &OrderedCloud,
+    formats: &Formats,
+    ctx: &FrameContext,
+) -> Result<Vec<WrittenFile>> {
     let name = format!("{stem}.pcd");
-    let n = super::pcd::write(&dir.join(&name), cloud, ascii)?;
+    let n = super::pcd::write_layout(
+        &dir.join(&name),
+        cloud,
+        formats.pcd_layout,
+        formats.pcd_ascii,
+        ctx.sensor_from_vehicle.as_ref(),
+    )?;
     Ok(vec![written(name, "pcd", n)])
 }
 
@@ -168,7 +185,7 @@ pub fn write_frame(
     let ((pcd, ply), (kitti, las)) = rayon::join(
         || {
             rayon::join(
-                || if formats.pcd { write_pcd(dir, &stem, cloud, formats.pcd_ascii) } else { none() },
+                || if formats.pcd { write_pcd(dir, &stem, cloud, formats, ctx) } else { none() },
                 || if formats.ply { write_ply(dir, &stem, cloud) } else { none() },
             )
         },

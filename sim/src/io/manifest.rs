@@ -85,6 +85,10 @@ pub struct Manifest {
     pub frame_period_s: f64,
     /// Frame in which KITTI files hold their points: `sensor` (single-sensor rig) or `vehicle`.
     pub kitti_frame: String,
+    /// Layout of the PCD files: `groundtruth` (ours), `velodyne` or `ouster` (the ROS drivers';
+    /// `sim::io::pcd::PcdLayout`). Absent in older manifests: `groundtruth`.
+    #[serde(default = "default_pcd_layout")]
+    pub pcd_layout: String,
     /// Echo planes of the grid (PCD HEIGHT = planes x merged rows).
     pub planes: usize,
     /// How the grid is ordered (a sentence).
@@ -93,6 +97,10 @@ pub struct Manifest {
     pub sensors: Vec<SensorEntry>,
     /// The frames.
     pub frames: Vec<FrameEntry>,
+}
+
+fn default_pcd_layout() -> String {
+    "groundtruth".into()
 }
 
 impl Manifest {
