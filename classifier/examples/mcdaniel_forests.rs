@@ -4,6 +4,7 @@
 //!
 //! ```sh
 //! cargo run --release -p classifier --example mcdaniel_forests [-- --write-model classifier/models/mcdaniel-forest.json]
+//!     [--note TEXT] [--heights] [--debug] [--max-iter N] [--eps X]
 //! ```
 //!
 //! Rigs as seed 002: `forest-sparse` with `sim/rigs/nodding-180.toml` (180 deg), `forest-moderate`
@@ -27,10 +28,18 @@ fn main() {
     let nodding_180 = concat!(env!("CARGO_MANIFEST_DIR"), "/../sim/rigs/nodding-180.toml");
     let scenes =
         [("forest-sparse", nodding_180), ("forest-moderate", "utm30lx-nodding"), ("forest-dense", "utm30lx-nodding")];
-    let max_iter: usize =
-        args.iter().position(|a| a == "--max-iter").and_then(|i| args.get(i + 1)).map_or(100_000, |s| s.parse().expect("--max-iter N"));
-    let eps: f64 = args.iter().position(|a| a == "--eps").and_then(|i| args.get(i + 1)).map_or(0.01, |s| s.parse().expect("--eps X"));
-    let train_params = TrainParams { svm: mcdaniel::SvmParams { max_iter, eps, ..Default::default() }, ..Default::default() };
+    let max_iter: usize = args
+        .iter()
+        .position(|a| a == "--max-iter")
+        .and_then(|i| args.get(i + 1))
+        .map_or(100_000, |s| s.parse().expect("--max-iter N"));
+    let eps: f64 = args
+        .iter()
+        .position(|a| a == "--eps")
+        .and_then(|i| args.get(i + 1))
+        .map_or(0.01, |s| s.parse().expect("--eps X"));
+    let train_params =
+        TrainParams { svm: mcdaniel::SvmParams { max_iter, eps, ..Default::default() }, ..Default::default() };
     let params = FeatureParams::default();
     let mut clouds = Vec::new();
     let mut sets: Vec<CandidateSet> = Vec::new();
@@ -77,7 +86,10 @@ fn main() {
             let mut neg: Vec<usize> = (0..set.len()).filter(|&k| !set.ground[k]).collect();
             neg.sort_by(|&a, &b| scores[b].total_cmp(&scores[a]));
             for &k in neg.iter().take(6) {
-                println!("  top negative {:?} score {:.3} at {} f {:?}", set.class[k], scores[k], set.point_in_vehicle[k], set.features[k]);
+                println!(
+                    "  top negative {:?} score {:.3} at {} f {:?}",
+                    set.class[k], scores[k], set.point_in_vehicle[k], set.features[k]
+                );
             }
         }
         println!(
@@ -88,12 +100,21 @@ fn main() {
             mcdaniel::roc::tpr_at_fpr_below(&curve, 0.07),
             mcdaniel::roc::tpr_at_fpr_below(&curve, 0.10),
         );
-        // Whole cloud.
-        let mut m = mcdaniel::McDaniel::new(model, Default::default()).expect("model");
-        let d = m.classify(&clouds[test]).expect("classify");
-        let mut eval = classifier::Evaluation::default();
-        eval.add_frame(&clouds[test], &d);
-        println!("  whole cloud: {:?}", eval.pooled.scores());
+        // Whole cloud, at the default height h and (with --heights) others.
+        let heights: &[f32] =
+            if args.iter().any(|a| a == "--heights") { &[0.05, 0.1, 0.15, 0.25, 0.5] } else { &[0.15] };
+        for &h in heights {
+            let params = mcdaniel::McDanielParams { ground_height_m: h, ..Default::default() };
+            let mut m = mcdaniel::McDaniel::new(model.clone(), params).expect("model");
+            let d = m.classify(&clouds[test]).expect("classify");
+            let mut eval = classifier::Evaluation::default();
+            eval.add_frame(&clouds[test], &d);
+            let s = eval.pooled.scores();
+            println!(
+                "  whole cloud, h = {h} m: acc {:.4} FPR {:.4} precision {:.4} recall {:.4} F1 {:.4}",
+                s.acc, s.fpr, s.precision, s.recall, s.f1
+            );
+        }
     }
     // Stage times on forest-dense (utm30lx-nodding, 200 x 1081), best of 10.
     let model = mcdaniel::train(&sets, &train_params).expect("train");
@@ -122,7 +143,8 @@ fn main() {
             ],
             "frames": 1,
             "measurement": "default effects (not ideal)",
-            "svm": "dual coordinate descent, L1-loss (hinge), C = 100, eps 0.01, bias as feature 1, seed 0",
+            "svm": format!("dual coordinate descent, L1-loss (hinge), C = 100, eps {eps}, at most {max_iter} passes, bias as feature 1, seed 0"),
+            "note": args.iter().position(|a| a == "--note").and_then(|i| args.get(i + 1)),
             "by": "cargo run --release -p classifier --example mcdaniel_forests -- --write-model classifier/models/mcdaniel-forest.json",
         });
         model.save(std::path::Path::new(&path)).expect("save");

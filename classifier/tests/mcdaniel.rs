@@ -269,7 +269,7 @@ fn decisions_go_to_every_return_within_h_above_a_ground_candidate() {
     // Column (0, 0): returns at 0.0 (the candidate), 0.2, 0.25 and 0.3; column (3, 0): one return.
     let pts = [at(0, 0, 0.2), at(0, 0, 0.0), at(0, 0, 0.3), at(3, 0, 1.0), at(0, 0, 0.25)];
     let origin = Vec3::new(0.0, 0.0, 2.0);
-    let known = || McDanielParams { sensor_origins: Some(vec![origin]), ..Default::default() };
+    let known = || McDanielParams { sensor_origins: Some(vec![origin]), ground_height_m: 0.25, ..Default::default() };
     let mut cloud = cloud_of(&pts, origin);
     // A no-return cell stays false.
     cloud.point_in_vehicle.push(Vec3::NAN);
