@@ -298,6 +298,25 @@ pub fn noise() -> impl Strategy<Value = bool> {
     any::<bool>()
 }
 
+/// A deterministic proptest configuration: [`cases`]`(default)` cases, the random stream seeded
+/// with `GT_PROPTEST_SEED` from the environment (default 0) so every run draws the same cases, and
+/// no failure-persistence files (a failing case is printed; keep it as a named test).
+///
+/// ```
+/// let config = groundtruth_scenario::strategies::config(3);
+/// assert!(config.cases >= 1);
+/// assert!(config.failure_persistence.is_none());
+/// ```
+pub fn config(default: u32) -> ProptestConfig {
+    let seed = std::env::var("GT_PROPTEST_SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
+    ProptestConfig {
+        cases: cases(default),
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    }
+}
+
 /// The proptest case count: `GT_PROPTEST_CASES` from the environment if set (a long run), else
 /// `default` (a CI-sized run).
 ///
