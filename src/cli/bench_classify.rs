@@ -40,6 +40,9 @@ pub struct Args {
     /// Time real files instead of a scan: a `.pcd` / `.bin` file or a directory of them.
     #[arg(long)]
     input: Option<std::path::PathBuf>,
+    /// With `--input`: the sensor's calibration file, as `classify --calibration`.
+    #[arg(long)]
+    calibration: Option<std::path::PathBuf>,
     /// Trained model file for `mcdaniel` (default: the bundled forest model).
     #[arg(long)]
     model: Option<std::path::PathBuf>,
@@ -84,6 +87,7 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
     } else {
         Some(args.rig.as_str())
     };
+    let setup = super::classify::SensorSetup::new(rig, args.calibration.as_deref())?;
     let repeats = args.repeats.max(1);
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -93,7 +97,7 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
         let mut last = None;
         for _ in 0..repeats {
             let t0 = Instant::now();
-            let (frame, read_ms) = super::classify::read_frame_timed(path, rig)?;
+            let (frame, read_ms) = super::classify::read_frame_timed(path, &setup)?;
             let t2 = Instant::now();
             let out = method.classify(&FrameInput { index, cloud: &frame.cloud, world_from_vehicle: None })?;
             let bytes = match &frame.report {

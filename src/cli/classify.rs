@@ -28,8 +28,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use classifier::FrameInput;
 use classifier::ordering::{
-    BeamTable, OrderingReport, PathChoice, PointAttributes, UnfoldParams, decisions_per_point, order_cloud,
-    order_organized,
+    BeamTable, Calibration, OrderingReport, PathChoice, PointAttributes, UnfoldParams, decisions_per_point,
+    order_cloud, order_organized,
 };
 use glam::{Affine3A, Mat4};
 use sim::OrderedCloud;
@@ -49,6 +49,10 @@ pub struct Args {
     /// Rig whose beam table orders KITTI .bin input (single-sensor rigs).
     #[arg(long)]
     rig: Option<String>,
+    /// The sensor's own calibration (per-laser elevations and offsets): our .toml or .txt, the
+    /// velodyne driver's .yaml, Ouster's metadata .json (see `classifier::ordering::calibration`).
+    #[arg(long)]
+    calibration: Option<PathBuf>,
     /// Seed of randomized methods (RANSAC).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -111,33 +115,85 @@ fn list_inputs(input: &Path) -> anyhow::Result<Vec<InputFrame>> {
 /// 10 Hz turn, so 2,083 columns would make every ring share cells.
 const KITTI_COLUMNS: usize = 2170;
 
-/// The beam table of a single-sensor rig (elevations, columns and origin offsets), with its mount.
-pub(crate) fn rig_table(name: &str) -> anyhow::Result<(BeamTable, Affine3A)> {
-    let rig = super::common::load_rig(name)?;
-    if rig.sensors.len() != 1 {
-        bail!("rig `{name}` has {} sensors; ordering a KITTI file needs a single-sensor rig", rig.sensors.len());
+/// What orders files from other tools: the beam table and the mount taking sensor-frame points to
+/// the vehicle frame.
+#[derive(Clone, Debug)]
+pub(crate) struct SensorSetup {
+    /// The beam table.
+    pub table: BeamTable,
+    /// Mount (identity without a rig).
+    pub vehicle_from_sensor: Affine3A,
+    /// Lasers of a calibration file, checked against organized clouds' rows.
+    pub calibrated_lasers: Option<usize>,
+}
+
+impl SensorSetup {
+    /// From `--rig` (a single-sensor rig: its table with origin offsets and its mount) and
+    /// `--calibration` (the unit's own angles, replacing the rig's or the default table's; the
+    /// columns from the file, else the rig, else [`KITTI_COLUMNS`]). Neither: the HDL-64E nominal
+    /// table with [`KITTI_COLUMNS`] columns, no mount.
+    pub fn new(rig: Option<&str>, calibration: Option<&Path>) -> anyhow::Result<Self> {
+        let (mut table, vehicle_from_sensor) = match rig {
+            Some(name) => {
+                let rig = super::common::load_rig(name)?;
+                if rig.sensors.len() != 1 {
+                    bail!(
+                        "rig `{name}` has {} sensors; ordering a file from another tool needs a single-sensor rig",
+                        rig.sensors.len()
+                    );
+                }
+                let s = &rig.sensors[0];
+                let table = BeamTable::from_pattern(&s.spec.pattern()).with_context(|| format!("rig `{name}`"))?;
+                // KITTI files and the drivers' clouds of a single-sensor rig hold sensor-frame points.
+                (table, s.mount.vehicle_from_sensor())
+            }
+            None => (BeamTable::hdl64e(KITTI_COLUMNS), Affine3A::IDENTITY),
+        };
+        let mut calibrated_lasers = None;
+        if let Some(file) = calibration {
+            let expected = rig.map(|_| table.elevations_rad.len());
+            let cal = Calibration::load(file, expected)?;
+            let cols = cal.columns.unwrap_or(if rig.is_some() { table.cols } else { KITTI_COLUMNS });
+            calibrated_lasers = Some(cal.lasers.len());
+            table = cal.to_table(cols);
+        }
+        Ok(Self { table, vehicle_from_sensor, calibrated_lasers })
     }
-    let s = &rig.sensors[0];
-    let table = BeamTable::from_pattern(&s.spec.pattern()).with_context(|| format!("rig `{name}`"))?;
-    // KITTI files of a single-sensor rig hold sensor-frame points.
-    Ok((table, s.mount.vehicle_from_sensor()))
+
+    /// Orders a flat cloud (KITTI `.bin`, unorganized PCD).
+    fn order_flat(
+        &self,
+        path: &Path,
+        points: &[glam::Vec3],
+        attributes: &PointAttributes<'_>,
+    ) -> anyhow::Result<(OrderedCloud, OrderingReport)> {
+        order_cloud(
+            points,
+            attributes,
+            &self.table,
+            self.vehicle_from_sensor,
+            PathChoice::Auto,
+            &UnfoldParams::default(),
+        )
+        .with_context(|| format!("ordering `{}`", path.display()))
+    }
 }
 
 /// A frame read and ordered: the cloud to classify and, for unordered input, what ordering did.
 pub(crate) struct ReadFrame {
     /// The cloud to classify.
     pub cloud: OrderedCloud,
-    /// For KITTI input: the ordering report (cell of every input point).
+    /// For input from other tools: the ordering report (cell of every input point).
     pub report: Option<OrderingReport>,
 }
 
-/// Reads a frame: the cloud to classify and, for KITTI, the ordering report.
-pub(crate) fn read_frame(path: &Path, rig: Option<&str>) -> anyhow::Result<ReadFrame> {
-    Ok(read_frame_timed(path, rig)?.0)
+/// Reads a frame: the cloud to classify and, for input from other tools, the ordering report.
+pub(crate) fn read_frame(path: &Path, setup: &SensorSetup) -> anyhow::Result<ReadFrame> {
+    Ok(read_frame_timed(path, setup)?.0)
 }
 
 /// As [`read_frame`], also returning the milliseconds spent reading the file (the rest is ordering).
-pub(crate) fn read_frame_timed(path: &Path, rig: Option<&str>) -> anyhow::Result<(ReadFrame, f64)> {
+pub(crate) fn read_frame_timed(path: &Path, setup: &SensorSetup) -> anyhow::Result<(ReadFrame, f64)> {
     let t0 = std::time::Instant::now();
     match path.extension().and_then(|e| e.to_str()) {
         Some("pcd") => {
@@ -147,51 +203,28 @@ pub(crate) fn read_frame_timed(path: &Path, rig: Option<&str>) -> anyhow::Result
                 return Ok((ReadFrame { cloud, report: None }, read_ms));
             }
             if info.organized {
-                let vehicle_from_sensor = match rig {
-                    Some(r) => rig_table(r)?.1,
-                    None => Affine3A::IDENTITY,
-                };
-                let (cloud, report) = order_organized(&cloud, info.has_ring, vehicle_from_sensor)
+                if let Some(n) = setup.calibrated_lasers
+                    && n != cloud.rows
+                {
+                    bail!("`{}` has {} rows but the calibration file {n} lasers", path.display(), cloud.rows);
+                }
+                let (cloud, report) = order_organized(&cloud, info.has_ring, setup.vehicle_from_sensor)
                     .with_context(|| format!("ordering the rows of `{}`", path.display()))?;
                 return Ok((ReadFrame { cloud, report: Some(report) }, read_ms));
             }
             // An unorganized PCD: ordered as a KITTI file is.
             let labels = cloud.label.iter().any(|l| l.0 != 0).then_some(cloud.label.as_slice());
-            let (table, vehicle_from_sensor) = match rig {
-                Some(r) => rig_table(r)?,
-                None => (BeamTable::hdl64e(KITTI_COLUMNS), Affine3A::IDENTITY),
-            };
             let attributes = PointAttributes { intensity: Some(&cloud.intensity), labels, time_s: Some(&cloud.time_s) };
-            let (ordered, report) = order_cloud(
-                &cloud.point_in_vehicle,
-                &attributes,
-                &table,
-                vehicle_from_sensor,
-                PathChoice::Auto,
-                &UnfoldParams::default(),
-            )
-            .with_context(|| format!("ordering `{}`", path.display()))?;
+            let (ordered, report) = setup.order_flat(path, &cloud.point_in_vehicle, &attributes)?;
             Ok((ReadFrame { cloud: ordered, report: Some(report) }, read_ms))
         }
         Some("bin") => {
             let label = path.with_extension("label");
             let flat = sim::io::kitti::read(path, label.is_file().then_some(label.as_path()))?;
             let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-            let (table, vehicle_from_sensor) = match rig {
-                Some(r) => rig_table(r)?,
-                None => (BeamTable::hdl64e(KITTI_COLUMNS), Affine3A::IDENTITY),
-            };
             let labels = label.is_file().then_some(flat.label.as_slice());
             let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, time_s: None };
-            let (cloud, report) = order_cloud(
-                &flat.point_in_vehicle,
-                &attributes,
-                &table,
-                vehicle_from_sensor,
-                PathChoice::Auto,
-                &UnfoldParams::default(),
-            )
-            .with_context(|| format!("ordering `{}`", path.display()))?;
+            let (cloud, report) = setup.order_flat(path, &flat.point_in_vehicle, &attributes)?;
             Ok((ReadFrame { cloud, report: Some(report) }, read_ms))
         }
         _ => bail!("`{}`: unsupported file type (expected .pcd or .bin)", path.display()),
@@ -202,9 +235,10 @@ pub(crate) fn read_frame_timed(path: &Path, rig: Option<&str>) -> anyhow::Result
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let frames = list_inputs(&args.input)?;
+    let setup = SensorSetup::new(args.rig.as_deref(), args.calibration.as_deref())?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating `{}`", args.out.display()))?;
     for f in &frames {
-        let ReadFrame { cloud, report } = read_frame(&f.path, args.rig.as_deref())?;
+        let ReadFrame { cloud, report } = read_frame(&f.path, &setup)?;
         if let Some(r) = &report {
             println!(
                 "{}: ordered into {} x {} x {}: {}",

@@ -287,3 +287,12 @@ pub fn wrap_into(mut x: f32, period: f32) -> f32 {
     }
     x
 }
+
+/// `x` rounded to the nearest integer (halves away from zero for positive `x`, up for negative),
+/// without a call to libm's `roundf` (not inlined without SSE4.1); `x` within +-2^31.
+#[inline]
+pub fn round_fast(x: f32) -> f32 {
+    let y = x + 0.5;
+    let t = y as i64 as f32;
+    if t > y { t - 1.0 } else { t }
+}

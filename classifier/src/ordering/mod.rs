@@ -11,6 +11,9 @@
 //! - **organized clouds** ([`organized`]) keep their cells; their rows are put in elevation order
 //!   from the `ring` field or the rows' elevations, whichever way up the file stores them;
 //!
+//! The beam table comes from a rig, a built-in nominal table, or the sensor's own calibration file
+//! ([`calibration`]: our TOML or text format, the velodyne driver's YAML, Ouster's metadata JSON).
+//!
 //! Columns come from each point's beam azimuth on every path. Points that share a cell are all kept
 //! ([`placement`]): the adjacent free column on the point's side, else a further plane of the same
 //! cell. Points with NaN or infinite coordinates are skipped (decision 0) and counted; more than
@@ -19,6 +22,7 @@
 //! placed.
 
 pub mod beam_table;
+pub mod calibration;
 pub mod organized;
 pub mod placement;
 pub mod report;
@@ -29,6 +33,7 @@ use glam::{Affine3A, Vec3};
 use sim::{OrderedCloud, SemanticClass};
 
 pub use beam_table::{BeamTable, TableRows};
+pub use calibration::{Calibration, CalibrationError};
 pub use organized::order_organized;
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};

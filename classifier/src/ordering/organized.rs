@@ -4,12 +4,13 @@
 //!
 //! With a `ring` field, each file row must hold one ring value below the row count, every row a
 //! different one (else the file is refused, naming the value); without, the file row index stands
-//! for the ring. Which way the rings go is told from the data: the Spearman rank correlation of the
-//! ring index with each row's median `tan(elevation)` (`z / d`) plus that with its median horizontal
-//! distance `d` (lower beams hit the ground nearer; both rise with the beam's elevation, in the
-//! sensor frame as in the vehicle frame). A sum above +0.5 means ring 0 is the bottom beam, below
-//! -0.5 the top beam; in between the layout cannot be told and the cloud is refused with a message,
-//! never guessed. Decisions come back in the input's own cell order through
+//! for the ring. Which way the rings go is told from the data, in any frame whose z is up: in each
+//! column, two neighbouring rings' points that lie on one surface (closer than [`SAME_SURFACE`] of
+//! their horizontal distance `d`) step from the lower beam to the upper one outwards on the ground
+//! and upwards on a wall, so `dz + dd > 0`. Each such pair votes; a balance
+//! `(up - down) / (up + down)` above [`MIN_DIRECTION_SCORE`] means ring 0 is the bottom beam, below
+//! its negative the top beam; in between the layout cannot be told and the cloud is refused with a
+//! message, never guessed. Decisions come back in the input's own cell order through
 //! [`OrderingReport::cell_of_point`].
 
 use sim::OrderedCloud;
@@ -17,37 +18,12 @@ use sim::OrderedCloud;
 use super::report::{OrderingPath, OrderingReport};
 use crate::error::{ClassifyError, Result};
 
-/// How far the rank correlations must lean before the rows' direction counts as told.
+/// How far the votes must lean (`(up - down) / (up + down)`) before the rows' direction counts as
+/// told.
 pub const MIN_DIRECTION_SCORE: f32 = 0.5;
 
-fn median(v: &mut [f32]) -> Option<f32> {
-    if v.is_empty() {
-        return None;
-    }
-    let m = v.len() / 2;
-    Some(*v.select_nth_unstable_by(m, f32::total_cmp).1)
-}
-
-/// Spearman's rank correlation of `(x, y)` pairs (no tie correction: ties get distinct ranks).
-fn spearman(pairs: &[(f32, f32)]) -> f32 {
-    let n = pairs.len();
-    if n < 2 {
-        return 0.0;
-    }
-    let rank = |key: &dyn Fn(&(f32, f32)) -> f32| {
-        let mut idx: Vec<usize> = (0..n).collect();
-        idx.sort_by(|&a, &b| key(&pairs[a]).total_cmp(&key(&pairs[b])));
-        let mut r = vec![0f32; n];
-        for (k, &i) in idx.iter().enumerate() {
-            r[i] = k as f32;
-        }
-        r
-    };
-    let (rx, ry) = (rank(&|p| p.0), rank(&|p| p.1));
-    let d2: f32 = rx.iter().zip(&ry).map(|(a, b)| (a - b) * (a - b)).sum();
-    let n = n as f32;
-    1.0 - 6.0 * d2 / (n * (n * n - 1.0))
-}
+/// Neighbouring points closer than this fraction of their horizontal distance lie on one surface.
+pub const SAME_SURFACE: f32 = 0.2;
 
 /// Puts the rows of an organized `cloud` (one plane, rows in file order) in elevation order.
 /// `has_ring`: whether the file had a `ring` field (then `cloud.ring` holds it). Points (and their
@@ -91,38 +67,48 @@ pub fn order_organized(
         seen[g] = true;
         *ring = g;
     }
-    // Per ring: median tan(elevation) and median horizontal distance of its returns.
-    let (mut el_pairs, mut d_pairs) = (Vec::new(), Vec::new());
-    let mut buf_e = Vec::with_capacity(cols);
-    let mut buf_d = Vec::with_capacity(cols);
+    // Which way up: in each column, the points of neighbouring rings on one surface (closer than
+    // `SAME_SURFACE` of their distance) step up or out from the lower beam to the upper one.
+    let mut row_of_ring = vec![0usize; rows];
     for (k, &g) in ring_of_row.iter().enumerate() {
-        buf_e.clear();
-        buf_d.clear();
-        for p in &cloud.point_in_vehicle[k * cols..(k + 1) * cols] {
-            if p.is_finite() {
-                let d = (p.x * p.x + p.y * p.y).sqrt();
-                if d > 0.0 {
-                    buf_e.push(p.z / d);
-                    buf_d.push(d);
-                }
+        row_of_ring[g] = k;
+    }
+    let (mut up, mut down, mut rings_with_returns) = (0usize, 0usize, 0usize);
+    for g in 0..rows {
+        let a = row_of_ring[g] * cols;
+        rings_with_returns += usize::from(cloud.point_in_vehicle[a..a + cols].iter().any(|p| p.is_finite()));
+        if g + 1 == rows {
+            break;
+        }
+        let b = row_of_ring[g + 1] * cols;
+        for c in 0..cols {
+            let (p, q) = (cloud.point_in_vehicle[a + c], cloud.point_in_vehicle[b + c]);
+            if !(p.is_finite() && q.is_finite()) {
+                continue;
+            }
+            let (dp, dq) = ((p.x * p.x + p.y * p.y).sqrt(), (q.x * q.x + q.y * q.y).sqrt());
+            if p.distance(q) > SAME_SURFACE * dp.min(dq) {
+                continue;
+            }
+            let step = (q.z - p.z) + (dq - dp);
+            if step > 0.0 {
+                up += 1;
+            } else if step < 0.0 {
+                down += 1;
             }
         }
-        if let (Some(e), Some(d)) = (median(&mut buf_e), median(&mut buf_d)) {
-            el_pairs.push((g as f32, e));
-            d_pairs.push((g as f32, d));
-        }
     }
-    if el_pairs.len() < 2 {
-        return Err(ClassifyError::Ordering(format!("{} rings hold returns: fewer than two", el_pairs.len())));
+    if rings_with_returns < 2 {
+        return Err(ClassifyError::Ordering(format!("{rings_with_returns} rings hold returns: fewer than two")));
     }
-    let score = spearman(&el_pairs) + spearman(&d_pairs);
+    let score = (up as f32 - down as f32) / (up + down).max(1) as f32;
     let bottom_first = if score > MIN_DIRECTION_SCORE {
         true
     } else if score < -MIN_DIRECTION_SCORE {
         false
     } else {
         return Err(ClassifyError::Ordering(format!(
-            "cannot tell which way up the rows are stored (rank correlation of ring with elevation and distance {score:.2}, needs beyond +-{MIN_DIRECTION_SCORE})"
+            "cannot tell which way up the rows are stored ({up} neighbouring pairs step up, {down} down; needs a balance beyond +-{MIN_DIRECTION_SCORE})"
         )));
     };
     let new_row: Vec<usize> = ring_of_row.iter().map(|&g| if bottom_first { g } else { rows - 1 - g }).collect();
@@ -155,7 +141,7 @@ pub fn order_organized(
     }
     report.placed = cloud.returns();
     report.no_returns = rows * cols - report.placed;
-    report.rings_found = el_pairs.len();
+    report.rings_found = rings_with_returns;
     Ok((out, report))
 }
 

@@ -1,13 +1,24 @@
 //! Putting points into cells so that every point keeps one: each point names a row and a
 //! fractional column; the point closest to a cell's column centre keeps the cell, a point that loses
-//! it moves to the adjacent column on its side if that is free, and otherwise stays in its cell on
-//! a further plane (plane 1, 2, ...), as a second echo would. The classifier decides planes > 0
+//! it moves to the adjacent column on its side if that is free, else to the nearest free column
+//! within [`NEAR_COLUMNS`] in its row, and otherwise stays in its cell on a further plane (plane 1,
+//! 2, ...), as a second echo would; where such points are fewer than [`MAX_SHARED_FRACTION`] of the
+//! cloud (a laser's turn overlapping its own start) they share their cell and its decision instead
+//! of costing a whole plane. The classifier decides planes > 0
 //! from the nearest plane-0 return (`nitsch::echoes_from_plane0`), so no point is left out.
 
 use glam::{Affine3A, Vec3};
 use sim::{OrderedCloud, SemanticClass};
 
 use super::report::OrderingReport;
+
+/// How far (columns) a point whose cell and side column are taken looks for a free cell in its row
+/// before it stays on a further plane.
+pub const NEAR_COLUMNS: usize = 16;
+
+/// Below this fraction of the points, points with no free cell nearby share their cell (and its
+/// decision) instead of being put on a further plane.
+pub const MAX_SHARED_FRACTION: f64 = 0.01;
 
 /// Where one point wants to go.
 #[derive(Clone, Copy, Debug)]
@@ -47,7 +58,7 @@ pub(crate) fn place(
     let mut off = vec![0f32; n];
     let mut cell_of_wish = vec![FREE; wishes.len()];
     let col_of = |steps: f32| -> Option<(usize, f32, Option<usize>)> {
-        let mut col = steps.round();
+        let mut col = super::beam_table::round_fast(steps);
         if full_turn && col >= cols as f32 {
             col -= cols as f32;
         }
@@ -105,6 +116,25 @@ pub(crate) fn place(
             report.moved += 1;
             continue;
         }
+        // The nearest free column within `NEAR_COLUMNS` in the same row.
+        if let Some(free) = (2..=NEAR_COLUMNS as isize)
+            .flat_map(|k| [k, -k])
+            .chain([-1, 1])
+            .filter_map(|k| {
+                let c2 = c as isize + k;
+                if full_turn {
+                    Some(c2.rem_euclid(cols as isize) as usize)
+                } else {
+                    usize::try_from(c2).ok().filter(|&a| a < cols)
+                }
+            })
+            .find(|&c2| owner[row0 + c2] == FREE)
+        {
+            owner[row0 + free] = w;
+            cell_of_wish[w as usize] = (row0 + free) as u32;
+            report.moved += 1;
+            continue;
+        }
         if depth.is_empty() {
             depth = vec![0; n];
         }
@@ -112,6 +142,16 @@ pub(crate) fn place(
         depth[cell] = depth[cell].saturating_add(1);
         stack.push((w, cell, depth[cell]));
         report.stacked += 1;
+    }
+    // A handful of such points (under `MAX_SHARED_FRACTION`: a laser's turn overlapping its start)
+    // share their cell's decision rather than cost a whole further plane.
+    if (stack.len() as f64) < MAX_SHARED_FRACTION * wishes.len() as f64 {
+        report.shared = stack.len();
+        report.stacked = 0;
+        for (w, cell, _) in stack {
+            cell_of_wish[w as usize] = cell as u32;
+        }
+        return (cell_of_wish, 1);
     }
     let planes = 1 + stack.iter().map(|s| s.2 as usize).max().unwrap_or(0);
     for (w, cell, d) in stack {
@@ -134,7 +174,26 @@ pub(crate) fn build_cloud(
     vehicle_from_sensor: Affine3A,
     report: &mut OrderingReport,
 ) -> OrderedCloud {
-    let mut cloud = OrderedCloud::empty(rows, cols, planes);
+    // Built here rather than by `OrderedCloud::empty` (whose rayon fill costs more than it saves on
+    // one core for a frame of this size).
+    let n = rows * cols * planes;
+    let mut cloud = OrderedCloud {
+        rows,
+        cols,
+        planes,
+        point_in_vehicle: vec![Vec3::NAN; n],
+        range_m: vec![f32::NAN; n],
+        intensity: vec![0.0; n],
+        ring: vec![0; n],
+        column: vec![0; n],
+        sensor: vec![u8::MAX; n],
+        time_s: vec![0.0; n],
+        echo: vec![0; n],
+        label: vec![SemanticClass::UNLABELED; n],
+        instance: vec![0; n],
+        ground: vec![false; n],
+        normal: vec![Vec3::ZERO; n],
+    };
     for (ring_index, (ring, column)) in
         cloud.ring.chunks_exact_mut(cols).zip(cloud.column.chunks_exact_mut(cols)).enumerate()
     {
@@ -147,6 +206,11 @@ pub(crate) fn build_cloud(
     for (wish, &cell) in wishes.iter().zip(cell_of_wish) {
         let k = wish.point as usize;
         let cell = cell as usize;
+        report.cell_of_point[k] = Some(cell as u32);
+        if cloud.range_m[cell].is_finite() {
+            // A shared cell keeps its first point.
+            continue;
+        }
         let p = points_in_sensor[k];
         cloud.point_in_vehicle[cell] = if identity { p } else { vehicle_from_sensor.transform_point3(p) };
         cloud.range_m[cell] = p.length();
@@ -162,7 +226,6 @@ pub(crate) fn build_cloud(
             cloud.label[cell] = l[k];
             cloud.ground[cell] = l[k].is_ground();
         }
-        report.cell_of_point[k] = Some(cell as u32);
     }
     cloud
 }

@@ -44,10 +44,14 @@ pub struct OrderingReport {
     pub rings_found: usize,
     /// Points placed in the cell their row and azimuth name.
     pub placed: usize,
-    /// Points whose cell was taken and that moved to the adjacent free column on their side.
+    /// Points whose cell was taken and that moved to a free column nearby (the adjacent one on their
+    /// side, else within `placement::NEAR_COLUMNS`).
     pub moved: usize,
-    /// Points whose cell and adjacent column were taken, kept on a further plane of the same cell.
+    /// Points with no free cell nearby, kept on a further plane of their own cell.
     pub stacked: usize,
+    /// Points with no free cell nearby that share their cell (and its decision) with its point:
+    /// fewer than `placement::MAX_SHARED_FRACTION` of the cloud (a turn overlapping its start).
+    pub shared: usize,
     /// Points beyond the beam table's lowest or highest beam (placed in the edge row, counted here
     /// as well).
     pub outside: usize,
@@ -58,20 +62,21 @@ pub struct OrderingReport {
 }
 
 impl OrderingReport {
-    /// Points that got a cell (placed + moved + stacked).
+    /// Points that got a cell (placed + moved + stacked + shared).
     pub fn kept(&self) -> usize {
-        self.placed + self.moved + self.stacked
+        self.placed + self.moved + self.stacked + self.shared
     }
 
     /// One line for the command line.
     pub fn summary(&self) -> String {
         let mut s = format!(
-            "path {}: {} points: {} in their cell, {} moved to the adjacent column, {} on a second plane, {} skipped (bad), {} no-returns",
+            "path {}: {} points: {} in their cell, {} moved to a free column nearby, {} on a further plane, {} sharing a cell, {} skipped (bad), {} no-returns",
             self.path.name(),
             self.cell_of_point.len(),
             self.placed,
             self.moved,
             self.stacked,
+            self.shared,
             self.skipped,
             self.no_returns
         );

@@ -26,7 +26,7 @@
 
 use glam::Vec3;
 
-use super::beam_table::{TableRows, fast_atan2, wrap_into};
+use super::beam_table::{TableRows, fast_atan2, round_fast, wrap_into};
 use super::placement::Wish;
 use super::report::OrderingReport;
 
@@ -308,7 +308,7 @@ pub(crate) fn unfold_wishes(
                 unwrapped += d;
             }
             prev_steps = steps;
-            let mut c = unwrapped.round();
+            let mut c = round_fast(unwrapped);
             if !last.is_nan() && (c - last) * col_dir < 1.0 {
                 c = last + col_dir;
             }

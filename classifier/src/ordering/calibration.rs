@@ -1,0 +1,285 @@
+//! Calibration files: a sensor's own per-laser elevations (and azimuth and origin offsets), so a
+//! user's unit is ordered with its own angles ([`Calibration::to_table`]). Formats, chosen by the
+//! file's extension:
+//!
+//! - `.toml`: our documented format. Angles in degrees, offsets in metres; every field but
+//!   `elevation_deg` optional (0):
+//!   ```toml
+//!   columns = 2083                      # optional: columns per turn
+//!   [[lasers]]
+//!   elevation_deg = 2.0
+//!   azimuth_offset_deg = -3.1           # left positive
+//!   horizontal_offset_m = 0.026         # beam origin left of the beam
+//!   vertical_offset_m = 0.21            # beam origin above the sensor origin
+//!   ```
+//! - `.txt`: one laser per line, `elevation_deg [azimuth_offset_deg]`, blank lines and `#` comments
+//!   ignored.
+//! - `.yaml` / `.yml`: the velodyne driver's calibration (`lasers:` with `laser_id`,
+//!   `vert_correction` and `rot_correction` in radians, optional `horiz_offset_correction` and
+//!   `vert_offset_correction` in metres; `num_lasers`), in either of the two styles the driver's
+//!   files use: one flow mapping per laser (`- {laser_id: 0, rot_correction: ...}`) or block
+//!   mappings (`- laser_id: 0` with the keys indented below). Only this subset of YAML is read (no
+//!   YAML library is in the dependency tree).
+//! - `.json`: Ouster sensor metadata: `beam_altitude_angles` and `beam_azimuth_angles` (degrees; at
+//!   the top level or under `beam_intrinsics`), columns from `lidar_mode` (`"1024x10"`; at the top
+//!   level or under `config_params`). Ouster's radial `lidar_origin_to_beam_origin_mm` moves a point
+//!   along its beam, not across rows or columns, and is not needed to order a cloud.
+//!
+//! Refused, naming the file: no lasers or more than 65535, a laser count other than the expected
+//! one (a rig's or an organized cloud's rows), non-finite or out-of-range angles (elevations within
+//! +-90 degrees, azimuth offsets within +-180), two lasers at one elevation, duplicate or missing
+//! velodyne `laser_id`s.
+
+use std::path::{Path, PathBuf};
+
+use super::beam_table::BeamTable;
+
+/// Errors of calibration files: each names the file.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("calibration file `{path}`: {message}")]
+pub struct CalibrationError {
+    /// The file.
+    pub path: PathBuf,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// One laser of a calibration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LaserCalibration {
+    /// Elevation, degrees (up positive).
+    pub elevation_deg: f64,
+    /// Azimuth offset from the encoder angle, degrees (left positive).
+    #[serde(default)]
+    pub azimuth_offset_deg: f64,
+    /// Beam origin left of the beam, metres.
+    #[serde(default)]
+    pub horizontal_offset_m: f64,
+    /// Beam origin above the sensor origin, metres.
+    #[serde(default)]
+    pub vertical_offset_m: f64,
+}
+
+/// A sensor's calibration: its lasers in the file's order (laser id order for velodyne files).
+#[derive(Clone, Debug, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Calibration {
+    /// Columns per turn, where the file says.
+    #[serde(default)]
+    pub columns: Option<usize>,
+    /// The lasers.
+    pub lasers: Vec<LaserCalibration>,
+}
+
+impl Calibration {
+    /// Reads and checks a calibration file (formats in the module docs); `expected_lasers`, when
+    /// given, must equal the file's laser count.
+    pub fn load(path: &Path, expected_lasers: Option<usize>) -> Result<Self, CalibrationError> {
+        let text = std::fs::read_to_string(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+        Self::parse(path, &text, expected_lasers)
+    }
+
+    /// Parses calibration `text` (from `path`, whose extension picks the format).
+    pub fn parse(path: &Path, text: &str, expected_lasers: Option<usize>) -> Result<Self, CalibrationError> {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        let cal = match ext.as_str() {
+            "toml" => toml::from_str::<Calibration>(text).map_err(|e| err(path, e.to_string()))?,
+            "txt" => parse_text(path, text)?,
+            "yaml" | "yml" => parse_velodyne_yaml(path, text)?,
+            "json" => parse_ouster_json(path, text)?,
+            other => {
+                return Err(err(path, format!("unknown extension `{other}` (allowed: toml, txt, yaml, yml, json)")));
+            }
+        };
+        cal.check(path, expected_lasers)?;
+        Ok(cal)
+    }
+
+    fn check(&self, path: &Path, expected: Option<usize>) -> Result<(), CalibrationError> {
+        let n = self.lasers.len();
+        if !(2..=u16::MAX as usize).contains(&n) {
+            return Err(err(path, format!("{n} lasers; needs 2 ..= 65535")));
+        }
+        if let Some(e) = expected
+            && e != n
+        {
+            return Err(err(path, format!("{n} lasers, but the sensor has {e}")));
+        }
+        if let Some(c) = self.columns
+            && !(2..=1 << 20).contains(&c)
+        {
+            return Err(err(path, format!("columns {c}; allowed 2 ..= 1048576")));
+        }
+        for (i, l) in self.lasers.iter().enumerate() {
+            let fields = [
+                ("elevation", l.elevation_deg, 90.0),
+                ("azimuth offset", l.azimuth_offset_deg, 180.0),
+                ("horizontal offset", l.horizontal_offset_m, 10.0),
+                ("vertical offset", l.vertical_offset_m, 10.0),
+            ];
+            for (name, v, limit) in fields {
+                if !v.is_finite() || v.abs() > limit {
+                    return Err(err(path, format!("laser {i}: {name} {v} is not finite or beyond +-{limit}")));
+                }
+            }
+        }
+        let mut e: Vec<f64> = self.lasers.iter().map(|l| l.elevation_deg).collect();
+        e.sort_by(f64::total_cmp);
+        if let Some(w) = e.windows(2).find(|w| w[0] == w[1]) {
+            return Err(err(path, format!("two lasers at elevation {} degrees", w[0])));
+        }
+        Ok(())
+    }
+
+    /// The beam table of this calibration with `cols` columns over a full turn (column 0 just right
+    /// of +pi, as `sim` grids).
+    pub fn to_table(&self, cols: usize) -> BeamTable {
+        let mut t =
+            BeamTable::spinning(self.lasers.iter().map(|l| (l.elevation_deg as f32).to_radians()).collect(), cols);
+        t.azimuth_offsets_rad = self.lasers.iter().map(|l| (l.azimuth_offset_deg as f32).to_radians()).collect();
+        t.horizontal_offsets_m = self.lasers.iter().map(|l| l.horizontal_offset_m as f32).collect();
+        t.vertical_offsets_m = self.lasers.iter().map(|l| l.vertical_offset_m as f32).collect();
+        t
+    }
+}
+
+fn err(path: &Path, message: impl Into<String>) -> CalibrationError {
+    CalibrationError { path: path.to_path_buf(), message: message.into() }
+}
+
+fn number(path: &Path, what: &str, s: &str) -> Result<f64, CalibrationError> {
+    s.trim().parse::<f64>().map_err(|_| err(path, format!("{what}: `{}` is not a number", s.trim())))
+}
+
+fn parse_text(path: &Path, text: &str) -> Result<Calibration, CalibrationError> {
+    let mut lasers = Vec::new();
+    for (k, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if words.len() > 2 {
+            return Err(err(path, format!("line {}: expected `elevation_deg [azimuth_offset_deg]`", k + 1)));
+        }
+        let what = format!("line {}", k + 1);
+        let elevation_deg = number(path, &what, words[0])?;
+        let azimuth_offset_deg = words.get(1).map(|w| number(path, &what, w)).transpose()?.unwrap_or(0.0);
+        lasers.push(LaserCalibration { elevation_deg, azimuth_offset_deg, ..Default::default() });
+    }
+    Ok(Calibration { columns: None, lasers })
+}
+
+/// The velodyne driver's calibration YAML (subset: module docs).
+fn parse_velodyne_yaml(path: &Path, text: &str) -> Result<Calibration, CalibrationError> {
+    // Each laser: its key-value pairs, from a flow mapping or a block of indented lines.
+    let mut lasers: Vec<Vec<(String, String)>> = Vec::new();
+    let mut in_lasers = false;
+    let mut num_lasers = None;
+    for (k, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("");
+        let trimmed = line.trim();
+        if trimmed.is_empty() {
+            continue;
+        }
+        let indented = line.starts_with(' ') || line.starts_with('\t');
+        if !indented && !trimmed.starts_with('-') {
+            in_lasers = trimmed.starts_with("lasers:");
+            if let Some(v) = trimmed.strip_prefix("num_lasers:") {
+                num_lasers = Some(number(path, "num_lasers", v)? as usize);
+            }
+            continue;
+        }
+        if !in_lasers {
+            continue;
+        }
+        let body = if let Some(rest) = trimmed.strip_prefix('-') {
+            lasers.push(Vec::new());
+            rest.trim()
+        } else {
+            trimmed
+        };
+        let Some(current) = lasers.last_mut() else {
+            return Err(err(path, format!("line {}: a laser's keys before its `-`", k + 1)));
+        };
+        let body = body.strip_prefix('{').map(|b| b.trim_end().trim_end_matches('}')).unwrap_or(body);
+        for pair in body.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            let (key, value) = pair
+                .split_once(':')
+                .ok_or_else(|| err(path, format!("line {}: `{pair}` is not `key: value`", k + 1)))?;
+            current.push((key.trim().to_string(), value.trim().to_string()));
+        }
+    }
+    if lasers.is_empty() {
+        return Err(err(path, "no `lasers:` list"));
+    }
+    let mut by_id: Vec<Option<LaserCalibration>> = vec![None; lasers.len()];
+    for (i, pairs) in lasers.iter().enumerate() {
+        let get = |key: &str| pairs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str());
+        let what = |key: &str| format!("laser {i} `{key}`");
+        let id = match get("laser_id") {
+            Some(v) => number(path, &what("laser_id"), v)? as usize,
+            None => return Err(err(path, format!("laser {i} has no `laser_id`"))),
+        };
+        if id >= lasers.len() || by_id[id].is_some() {
+            return Err(err(path, format!("laser_id {id} repeated or beyond the {} lasers", lasers.len())));
+        }
+        let rad = |key: &str| -> Result<f64, CalibrationError> {
+            match get(key) {
+                Some(v) => Ok(number(path, &what(key), v)?.to_degrees()),
+                None => Ok(0.0),
+            }
+        };
+        let metres = |key: &str| -> Result<f64, CalibrationError> {
+            get(key).map(|v| number(path, &what(key), v)).transpose().map(|v| v.unwrap_or(0.0))
+        };
+        if get("vert_correction").is_none() {
+            return Err(err(path, format!("laser {i} has no `vert_correction`")));
+        }
+        by_id[id] = Some(LaserCalibration {
+            elevation_deg: rad("vert_correction")?,
+            azimuth_offset_deg: rad("rot_correction")?,
+            horizontal_offset_m: metres("horiz_offset_correction")?,
+            vertical_offset_m: metres("vert_offset_correction")?,
+        });
+    }
+    if let Some(n) = num_lasers
+        && n != lasers.len()
+    {
+        return Err(err(path, format!("num_lasers {n} but {} lasers listed", lasers.len())));
+    }
+    Ok(Calibration { columns: None, lasers: by_id.into_iter().map(|l| l.expect("every id filled")).collect() })
+}
+
+/// Ouster sensor metadata JSON (module docs).
+fn parse_ouster_json(path: &Path, text: &str) -> Result<Calibration, CalibrationError> {
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| err(path, format!("not JSON: {e}")))?;
+    let find = |key: &str, parent: &str| v.get(key).or_else(|| v.get(parent).and_then(|p| p.get(key)));
+    let angles = |key: &str| -> Result<Vec<f64>, CalibrationError> {
+        let a = find(key, "beam_intrinsics")
+            .and_then(|a| a.as_array())
+            .ok_or_else(|| err(path, format!("no `{key}` array")))?;
+        a.iter()
+            .enumerate()
+            .map(|(i, x)| x.as_f64().ok_or_else(|| err(path, format!("`{key}`[{i}] is not a number"))))
+            .collect()
+    };
+    let alt = angles("beam_altitude_angles")?;
+    let az = angles("beam_azimuth_angles")?;
+    if alt.len() != az.len() {
+        return Err(err(path, format!("{} altitude angles but {} azimuth angles", alt.len(), az.len())));
+    }
+    let columns = find("lidar_mode", "config_params")
+        .and_then(|m| m.as_str())
+        .and_then(|m| m.split('x').next())
+        .and_then(|c| c.parse::<usize>().ok());
+    Ok(Calibration {
+        columns,
+        lasers: alt
+            .iter()
+            .zip(&az)
+            .map(|(&e, &a)| LaserCalibration { elevation_deg: e, azimuth_offset_deg: a, ..Default::default() })
+            .collect(),
+    })
+}

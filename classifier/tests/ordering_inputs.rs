@@ -1,0 +1,168 @@
+//! Ordering recovery on hand-made clouds: scan unfolding of a KITTI-like scan order (with extra
+//! wraps at +-pi inside a turn), the beam-table fallback for a shuffled cloud, bad points skipped
+//! and counted, bad clouds refused, organized clouds stored top-first or without a ring field.
+
+use classifier::ordering::{
+    BeamTable, OrderingPath, PathChoice, PointAttributes, UnfoldParams, decisions_per_point, order_cloud,
+    order_organized,
+};
+use glam::{Affine3A, Vec3};
+
+/// A 16-laser sensor over a flat floor 1.8 m below, `cols` columns; points in KITTI order (top laser
+/// first, each a counter-clockwise turn from the front), with each point's true `(row, col)`.
+fn kitti_like(cols: usize) -> (BeamTable, Vec<Vec3>, Vec<(usize, usize)>) {
+    let elevations: Vec<f32> = (0..16).map(|i| (-15.0 + 2.0 * i as f32).to_radians()).collect();
+    let table = BeamTable::spinning(elevations.clone(), cols);
+    let mut pts = Vec::new();
+    let mut truth = Vec::new();
+    for row in (0..16).rev() {
+        let front = cols / 2;
+        for k in 0..cols {
+            let col = (front + cols - k) % cols;
+            let az = table.azimuth_left_rad - table.azimuth_step_rad * col as f32;
+            let el = elevations[row];
+            // A wall at 30 m for upward beams, the floor for downward ones.
+            let r = if el < -0.01 { 1.8 / (-el).sin() } else { 30.0 / el.cos() };
+            let d = Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            pts.push(d * r);
+            truth.push((row, col));
+        }
+    }
+    (table, pts, truth)
+}
+
+#[test]
+fn scan_order_unfolds_into_true_cells_despite_jitter_at_the_back() {
+    let (table, mut pts, truth) = kitti_like(360);
+    // Jitter: a point at the back steps just across +-pi and back (an extra wrap inside a turn).
+    let back = pts.iter().position(|p| (p.y.atan2(p.x) + std::f32::consts::PI).abs() < 0.012).unwrap();
+    pts[back].y = -pts[back].y;
+    let (cloud, report) = order_cloud(
+        &pts,
+        &PointAttributes::default(),
+        &table,
+        Affine3A::IDENTITY,
+        PathChoice::Auto,
+        &UnfoldParams::default(),
+    )
+    .unwrap();
+    assert_eq!(report.path, OrderingPath::Unfolded, "{}", report.summary());
+    assert_eq!(report.rings_found, 16);
+    assert_eq!(report.kept(), pts.len());
+    let right =
+        truth.iter().enumerate().filter(|&(k, &(r, c))| report.cell_of_point[k] == Some((r * 360 + c) as u32)).count();
+    assert!(right >= pts.len() - 2, "{right} of {} in their true cell", pts.len());
+    assert_eq!((cloud.rows, cloud.cols), (16, 360));
+}
+
+#[test]
+fn shuffled_points_fall_back_to_the_beam_table_and_bad_points_are_counted() {
+    let (table, pts, truth) = kitti_like(360);
+    let n = pts.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    for k in (1..n).rev() {
+        order.swap(k, (k * 7919 + 13) % (k + 1));
+    }
+    let mut shuffled: Vec<Vec3> = order.iter().map(|&k| pts[k]).collect();
+    // A handful of bad points and no-returns: skipped, decision 0, counted.
+    shuffled[5] = Vec3::new(f32::NAN, 0.0, 0.0);
+    shuffled[77] = Vec3::new(0.0, f32::INFINITY, 0.0);
+    shuffled[99] = Vec3::ZERO;
+    let (cloud, report) = order_cloud(
+        &shuffled,
+        &PointAttributes::default(),
+        &table,
+        Affine3A::IDENTITY,
+        PathChoice::Auto,
+        &UnfoldParams::default(),
+    )
+    .unwrap();
+    assert_eq!(report.path, OrderingPath::BeamTable);
+    assert!(report.fallback.is_some(), "{}", report.summary());
+    assert_eq!((report.skipped, report.no_returns), (2, 1));
+    assert_eq!(report.kept(), n - 3);
+    for k in [5, 77, 99] {
+        assert_eq!(report.cell_of_point[k], None);
+    }
+    let right = (0..n)
+        .filter(|&k| report.cell_of_point[k] == Some((truth[order[k]].0 * 360 + truth[order[k]].1) as u32))
+        .count();
+    assert_eq!(right, n - 3);
+    let ground = vec![true; cloud.len()];
+    let d = decisions_per_point(&report, &ground);
+    assert_eq!((d[5], d[77], d[99], d[0]), (0, 0, 0, 1));
+}
+
+#[test]
+fn bad_clouds_are_refused() {
+    let (table, mut pts, _) = kitti_like(90);
+    let attrs = PointAttributes::default();
+    let order =
+        |p: &[Vec3]| order_cloud(p, &attrs, &table, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default());
+    // More than 1 % NaN.
+    let n = pts.len();
+    for p in pts.iter_mut().take(n / 50) {
+        *p = Vec3::NAN;
+    }
+    let e = order(&pts).unwrap_err().to_string();
+    assert!(e.contains("NaN or infinite"), "{e}");
+    // One ring in the table.
+    let one = BeamTable::spinning(vec![0.0], 90);
+    assert!(
+        order_cloud(&pts[n / 2..], &attrs, &one, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default())
+            .is_err()
+    );
+    // Unfolding alone on shuffled points: refused, saying why.
+    let mut shuffled = pts[n / 2..].to_vec();
+    shuffled.reverse();
+    shuffled.swap(3, 400);
+    shuffled.swap(10, 700);
+    let e = order_cloud(&shuffled, &attrs, &table, Affine3A::IDENTITY, PathChoice::Unfold, &UnfoldParams::default());
+    assert!(e.is_err() || e.unwrap().1.rings_found <= 16);
+}
+
+#[test]
+fn organized_top_first_or_without_ring_gives_the_bottom_first_decisions() {
+    let bottom = classifier::synthetic::noisy_cars_frame(0.05, 3, true, 0.01);
+    let mut m = classifier::Nitsch::new(Default::default()).unwrap();
+    let reference = m.classify(&bottom).unwrap();
+    let (rows, cols) = (bottom.rows, bottom.cols);
+    // Reverse the rows (ouster-ros: row 0 = ring 0 = top beam).
+    let mut top = bottom.clone();
+    for k in 0..rows {
+        let src = (rows - 1 - k) * cols;
+        top.point_in_vehicle[k * cols..(k + 1) * cols].copy_from_slice(&bottom.point_in_vehicle[src..src + cols]);
+        top.range_m[k * cols..(k + 1) * cols].copy_from_slice(&bottom.range_m[src..src + cols]);
+        top.ring[k * cols..(k + 1) * cols].fill(k as u16);
+    }
+    for has_ring in [true, false] {
+        let (ordered, report) = order_organized(&top, has_ring, Affine3A::IDENTITY).unwrap();
+        assert_eq!(report.path, OrderingPath::Organized);
+        let d = decisions_per_point(&report, &m.classify(&ordered).unwrap());
+        for k in 0..rows {
+            for c in 0..cols {
+                let want = reference[(rows - 1 - k) * cols + c];
+                assert_eq!(d[k * cols + c] == 1, want, "row {k} col {c} (ring field {has_ring})");
+            }
+        }
+    }
+    // A ring value out of range, or two rows of one ring: refused.
+    let mut bad = top.clone();
+    bad.ring[..cols].fill(rows as u16);
+    let e = order_organized(&bad, true, Affine3A::IDENTITY).unwrap_err().to_string();
+    assert!(e.contains("out of range"), "{e}");
+    let mut twice = top.clone();
+    twice.ring[..cols].fill(1);
+    assert!(order_organized(&twice, true, Affine3A::IDENTITY).unwrap_err().to_string().contains("more than one row"));
+    // No way up to tell: every row the same.
+    let mut flat = top.clone();
+    let fullest = (0..rows)
+        .max_by_key(|&k| top.point_in_vehicle[k * cols..(k + 1) * cols].iter().filter(|p| p.is_finite()).count())
+        .unwrap();
+    let row0: Vec<Vec3> = flat.point_in_vehicle[fullest * cols..(fullest + 1) * cols].to_vec();
+    for k in 1..rows {
+        flat.point_in_vehicle[k * cols..(k + 1) * cols].copy_from_slice(&row0);
+    }
+    let e = order_organized(&flat, false, Affine3A::IDENTITY).unwrap_err().to_string();
+    assert!(e.contains("cannot tell"), "{e}");
+}
