@@ -8,6 +8,7 @@
 //! feature). Ties in z go to the lowest cell index of the cloud.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::FeatureParams;
 
@@ -47,23 +48,32 @@ impl Columns {
         let cell_m = params.cell_m;
         let lim = params.max_extent_m;
         let n = cloud.len();
-        let mut ij = vec![(0i32, 0i32); n];
-        let mut inside = vec![false; n];
-        let (mut imin, mut imax, mut jmin, mut jmax) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
-        for c in 0..n {
-            let p = cloud.point_in_vehicle[c];
-            if !cloud.has_return(c) || !p.is_finite() || p.x.abs() > lim || p.y.abs() > lim {
-                continue;
-            }
-            let i = (p.x / cell_m).floor() as i32;
-            let j = (p.y / cell_m).floor() as i32;
-            ij[c] = (i, j);
-            inside[c] = true;
-            imin = imin.min(i);
-            imax = imax.max(i);
-            jmin = jmin.min(j);
-            jmax = jmax.max(j);
-        }
+        // Column indices of every usable return (parallel; i32::MIN marks the others), and their
+        // bounding box (an exact integer reduction: independent of the thread count).
+        let ij: Vec<(i32, i32)> = (0..n)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|c| {
+                let p = cloud.point_in_vehicle[c];
+                if !cloud.has_return(c) || !p.is_finite() || p.x.abs() > lim || p.y.abs() > lim {
+                    (i32::MIN, i32::MIN)
+                } else {
+                    ((p.x / cell_m).floor() as i32, (p.y / cell_m).floor() as i32)
+                }
+            })
+            .collect();
+        let (imin, imax, jmin, jmax) = ij
+            .par_iter()
+            .with_min_len(4096)
+            .filter(|(i, _)| *i != i32::MIN)
+            .fold(
+                || (i32::MAX, i32::MIN, i32::MAX, i32::MIN),
+                |(a, b, c, d), &(i, j)| (a.min(i), b.max(i), c.min(j), d.max(j)),
+            )
+            .reduce(
+                || (i32::MAX, i32::MIN, i32::MAX, i32::MIN),
+                |x, y| (x.0.min(y.0), x.1.max(y.1), x.2.min(y.2), x.3.max(y.3)),
+            );
         if imin > imax {
             return Self { cell_m, column_of_cell: vec![NONE; n], ..Default::default() };
         }
@@ -71,11 +81,10 @@ impl Columns {
         let nj = (jmax - jmin + 1) as usize;
         let mut best = vec![NONE; ni * nj];
         let mut column_of_cell = vec![NONE; n];
-        for c in 0..n {
-            if !inside[c] {
+        for (c, &(i, j)) in ij.iter().enumerate() {
+            if i == i32::MIN {
                 continue;
             }
-            let (i, j) = ij[c];
             let g = (i - imin) as usize * nj + (j - jmin) as usize;
             column_of_cell[c] = g as u32;
             let b = best[g];
