@@ -34,16 +34,17 @@ pub fn ray_trace_counts(cloud: &sim::OrderedCloud, columns: &Columns, origins: &
     if m == 0 {
         return Vec::new();
     }
-    // Per grid column, the floor of its candidate's voxel; -inf for an empty column (never counts).
+    // Per grid column, the floor of its candidate's voxel and the candidate; -inf for an empty
+    // column (never counts).
     let cell = f64::from(columns.cell_m);
-    let floor_z: Vec<f64> = columns
+    let column: Vec<(f64, u32)> = columns
         .candidate_of_column
         .iter()
         .map(|&k| {
             if k == NONE {
-                f64::NEG_INFINITY
+                (f64::NEG_INFINITY, 0)
             } else {
-                f64::from(columns.layer(columns.point_in_vehicle[k as usize].z)) * cell
+                (f64::from(columns.layer(columns.point_in_vehicle[k as usize].z)) * cell, k)
             }
         })
         .collect();
@@ -53,8 +54,7 @@ pub fn ray_trace_counts(cloud: &sim::OrderedCloud, columns: &Columns, origins: &
         j0: f64::from(columns.j0),
         ni: columns.ni,
         nj: columns.nj,
-        floor_z: &floor_z,
-        candidate_of_column: &columns.candidate_of_column,
+        column: &column,
     };
     let n = cloud.len();
     (0..n)
@@ -92,8 +92,8 @@ struct Walker<'a> {
     j0: f64,
     ni: usize,
     nj: usize,
-    floor_z: &'a [f64],
-    candidate_of_column: &'a [u32],
+    /// Per grid column: (floor of the candidate's voxel, candidate).
+    column: &'a [(f64, u32)],
 }
 
 impl Walker<'_> {
@@ -146,13 +146,18 @@ impl Walker<'_> {
         let mut t_max_u = next_t(cu, u0, du);
         let mut t_max_v = next_t(cv, v0, dv);
         let mut t_cur = t_start;
+        // Grid column index, kept up to date as the walk steps.
+        let nj = self.nj as i64;
+        let mut g = cu * nj + cv;
+        let step_g_u = step_u * nj;
         loop {
             let t_exit = t_max_u.min(t_max_v).min(t_hi);
             if t_exit > t_cur {
-                let g = cu as usize * self.nj + cv as usize;
-                let z_lo = (z0 + t_cur * dz).min(z0 + t_exit * dz);
-                if z_lo < self.floor_z[g] {
-                    counts[self.candidate_of_column[g] as usize] += 1;
+                // z is linear in t: the lower end is the exit going down, the entry going up.
+                let z_lo = z0 + if dz <= 0.0 { t_exit } else { t_cur } * dz;
+                let (floor, k) = self.column[g as usize];
+                if z_lo < floor {
+                    counts[k as usize] += 1;
                 }
             }
             if t_exit >= t_hi {
@@ -161,12 +166,14 @@ impl Walker<'_> {
             t_cur = t_exit;
             if t_max_u < t_max_v {
                 cu += step_u;
+                g += step_g_u;
                 t_max_u += delta_u;
             } else {
                 cv += step_v;
+                g += step_v;
                 t_max_v += delta_v;
             }
-            if cu < 0 || cv < 0 || cu >= self.ni as i64 || cv >= self.nj as i64 {
+            if cu < 0 || cv < 0 || cu >= self.ni as i64 || cv >= nj {
                 break;
             }
         }
