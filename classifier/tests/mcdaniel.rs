@@ -355,6 +355,9 @@ fn model_files_round_trip_and_bad_ones_are_refused_with_the_file_named() {
     assert_eq!(m.name(), "mcdaniel");
     let cloud = sim::OrderedCloud::empty(2, 2, 1);
     assert_eq!(m.classify(&FrameInput { index: 0, cloud: &cloud, world_from_vehicle: None }).unwrap(), vec![false; 4]);
+    // Stage times through the registry's trait: every stage named, in pipeline order.
+    let names: Vec<&str> = m.named_stage_times().iter().map(|s| s.0).collect();
+    assert_eq!(names, ["origins", "stage1", "f1-f6", "f7", "f8", "svm", "propagate"]);
     assert_eq!(method_by_name("mcdaniel", 0).unwrap().name(), "mcdaniel");
 }
 
