@@ -4,7 +4,7 @@
 //!
 //! ```sh
 //! cargo run --release -p classifier --example mcdaniel_forests [-- --write-model classifier/models/mcdaniel-forest.json]
-//!     [--note TEXT] [--heights] [--debug] [--max-iter N] [--eps X]
+//!     [--note TEXT] [--heights] [--debug] [--max-iter N] [--eps X] [--pyramid LAYERS]
 //! ```
 //!
 //! Rigs as seed 002: `forest-sparse` with `sim/rigs/nodding-180.toml` (180 deg), `forest-moderate`
@@ -40,7 +40,12 @@ fn main() {
         .map_or(0.01, |s| s.parse().expect("--eps X"));
     let train_params =
         TrainParams { svm: mcdaniel::SvmParams { max_iter, eps, ..Default::default() }, ..Default::default() };
-    let params = FeatureParams::default();
+    let pyramid_layers: u32 = args
+        .iter()
+        .position(|a| a == "--pyramid")
+        .and_then(|i| args.get(i + 1))
+        .map_or(4, |s| s.parse().expect("--pyramid N"));
+    let params = FeatureParams { pyramid_layers, ..FeatureParams::default() };
     let mut clouds = Vec::new();
     let mut sets: Vec<CandidateSet> = Vec::new();
     for (scene, rig) in scenes {
