@@ -4,7 +4,7 @@
 //!
 //! ```sh
 //! cargo run --release -p classifier --example mcdaniel_forests [-- --write-model classifier/models/mcdaniel-forest.json]
-//!     [--note TEXT] [--heights] [--debug] [--max-iter N] [--eps X] [--pyramid LAYERS]
+//!     [--note TEXT] [--heights] [--debug] [--max-iter N] [--eps X] [--pyramid LAYERS] [--drop K]
 //! ```
 //!
 //! Rigs as seed 002: `forest-sparse` with `sim/rigs/nodding-180.toml` (180 deg), `forest-moderate`
@@ -52,7 +52,12 @@ fn main() {
         let t = Instant::now();
         let cloud = scan(scene, rig);
         let scan_s = t.elapsed().as_secs_f64();
-        let set = mcdaniel::candidates(&cloud, &params, None).expect("candidates");
+        let mut set = mcdaniel::candidates(&cloud, &params, None).expect("candidates");
+        // --drop K (1..=8): feature K held at 0 (an ablation; the model learns no weight for it).
+        if let Some(k) = args.iter().position(|a| a == "--drop").and_then(|i| args.get(i + 1)) {
+            let k: usize = k.parse().expect("--drop 1..=8");
+            set.features.iter_mut().for_each(|f| f[k - 1] = 0.0);
+        }
         let origins = classifier::sensor_origin::estimate_origins(&cloud);
         println!(
             "{scene}: {} x {} cells, {} returns, {} candidates ({} ground) ; scan {scan_s:.2} s ; origin {:?}",
