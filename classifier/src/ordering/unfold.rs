@@ -30,6 +30,10 @@ use super::beam_table::{TableRows, fast_atan2, round_fast, wrap_into};
 use super::placement::Wish;
 use super::report::OrderingReport;
 
+/// Within a ring, a step of the columns against the scan direction by more than this is a gap
+/// going forward the long way round, not a step back.
+const MAX_BACK_COLUMNS: f32 = 8.0;
+
 /// Parameters of scan unfolding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UnfoldParams {
@@ -299,13 +303,10 @@ pub(crate) fn unfold_wishes(
             if prev_steps.is_nan() {
                 unwrapped = steps;
             } else {
-                let mut d = steps - prev_steps;
-                if d >= 0.5 * cols {
-                    d -= cols;
-                } else if d < -0.5 * cols {
-                    d += cols;
-                }
-                unwrapped += d;
+                // Progress in the scan direction, in columns: a ring only moves forward, so a step
+                // back of more than `MAX_BACK_COLUMNS` (jitter, parallax) is a gap the long way round.
+                let fwd = wrap_into((steps - prev_steps) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS;
+                unwrapped += fwd * col_dir;
             }
             prev_steps = steps;
             let mut c = round_fast(unwrapped);
