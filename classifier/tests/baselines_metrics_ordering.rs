@@ -90,8 +90,8 @@ fn a_point_that_loses_its_cell_moves_to_the_free_adjacent_column() {
     let pts = [at(130.0), at(100.0), at(135.0)];
     let (_, report) = order_points(&pts, None, &table, Affine3A::IDENTITY).unwrap();
     // 135 is best centred in column 0. The losers move in input order: 100 takes column 1 (its
-    // side), 130, evicted later, finds column 1 taken and stays in column 0 on plane 1 (cell
-    // 1 * 2 * 4 + 0 = 8): no point is dropped.
-    assert_eq!(report.cell_of_point, vec![Some(8), Some(1), Some(0)]);
-    assert_eq!((report.placed, report.moved, report.stacked), (1, 1, 1));
+    // side), 130, evicted later, finds column 1 taken and takes the nearest free column in its row
+    // (column 2): no point is dropped.
+    assert_eq!(report.cell_of_point, vec![Some(2), Some(1), Some(0)]);
+    assert_eq!((report.placed, report.moved, report.stacked), (1, 2, 0));
 }
