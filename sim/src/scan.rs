@@ -19,6 +19,8 @@
 //! - a row draws its noise stream only up to its last column with a hit (a prefix: same numbers);
 //! - each triangle's normal and surface index sit in one 16-byte record (one cache miss per hit).
 
+use std::sync::Arc;
+
 use glam::{Affine3A, Vec3};
 
 use crate::cast::{Backend, Caster, Hit, Ray};
@@ -98,11 +100,11 @@ pub struct Frame {
 /// A rig placed in a scene, ready to scan frames.
 pub struct Scanner<'a> {
     mesh: &'a SceneMesh,
-    caster: Box<dyn Caster>,
+    caster: Arc<dyn Caster>,
     /// Per triangle, its world normal and surface record side by side (one cache miss per hit, not two).
-    triangles: Vec<TriangleRecord>,
+    triangles: Arc<Vec<TriangleRecord>>,
     /// The scene's distinct surface records, indexed by [`TriangleRecord::surface`].
-    surfaces: Vec<Surface>,
+    surfaces: Arc<Vec<Surface>>,
     patterns: Vec<ScanPattern>,
     measurements: Vec<Measurement>,
     vehicle_from_sensor: Vec<Affine3A>,
@@ -121,6 +123,32 @@ pub struct Scanner<'a> {
     config: ScanConfig,
 }
 
+/// What scanning a scene needs of it regardless of the rig: the caster's acceleration structure
+/// and the per-triangle records. Built once and shared by many [`Scanner`]s
+/// ([`Scanner::with_prepared`]), e.g. a sweep over many mounts of one scene.
+#[derive(Clone)]
+pub struct PreparedScene {
+    backend: Backend,
+    triangle_count: usize,
+    caster: Arc<dyn Caster>,
+    triangles: Arc<Vec<TriangleRecord>>,
+    surfaces: Arc<Vec<Surface>>,
+}
+
+impl PreparedScene {
+    /// Builds `backend`'s acceleration structure and the triangle records of `mesh`.
+    pub fn new(mesh: &SceneMesh, backend: Backend) -> Self {
+        let (triangles, surfaces) = triangle_records(mesh);
+        Self {
+            backend,
+            triangle_count: mesh.len(),
+            caster: Arc::from(backend.build(mesh)),
+            triangles: Arc::new(triangles),
+            surfaces: Arc::new(surfaces),
+        }
+    }
+}
+
 /// Casts all frames of a scan and returns them (for small scans; large ones use [`Scanner`] frame by frame).
 pub fn scan(mesh: &SceneMesh, rig: &Rig, config: &ScanConfig) -> Result<Vec<Frame>> {
     let scanner = Scanner::new(mesh, rig, config.clone())?;
@@ -133,8 +161,29 @@ impl<'a> Scanner<'a> {
         config.validate()?;
         rig.validate()?;
         mesh.validate().map_err(|m| SimError::invalid("scene mesh", m, "finite vertices, valid indices"))?;
-        let caster = config.backend.build(mesh);
-        let (triangles, surfaces) = triangle_records(mesh);
+        let prepared = PreparedScene::new(mesh, config.backend);
+        Self::with_prepared(mesh, rig, config, &prepared)
+    }
+
+    /// Like [`Scanner::new`] with the scene's caster and triangle records taken from `prepared`
+    /// (built from the same `mesh` with `config.backend`) instead of building them.
+    pub fn with_prepared(
+        mesh: &'a SceneMesh,
+        rig: &'a Rig,
+        config: ScanConfig,
+        prepared: &PreparedScene,
+    ) -> Result<Self> {
+        config.validate()?;
+        rig.validate()?;
+        if prepared.triangle_count != mesh.len() || prepared.backend != config.backend {
+            return Err(SimError::invalid(
+                "prepared scene",
+                format!("{} triangles, {}", prepared.triangle_count, prepared.backend.name()),
+                format!("built from this mesh ({} triangles) with {}", mesh.len(), config.backend.name()),
+            ));
+        }
+        let caster = Arc::clone(&prepared.caster);
+        let (triangles, surfaces) = (Arc::clone(&prepared.triangles), Arc::clone(&prepared.surfaces));
         let patterns: Vec<ScanPattern> = rig.sensors.iter().map(|s| s.spec.pattern()).collect();
         let shot_times = patterns.iter().map(ShotTimes::new).collect();
         let measurements: Vec<Measurement> = rig

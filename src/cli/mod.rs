@@ -14,6 +14,8 @@ mod render_scan;
 mod render_scene;
 mod scan;
 mod scene;
+mod shard;
+mod sweep;
 mod train;
 
 use clap::{Parser, Subcommand};
@@ -45,6 +47,8 @@ enum Command {
     Eval(eval::Args),
     /// Train a learning method (McDaniel et al.'s SVM) on scans and write the model (JSON).
     Train(train::Args),
+    /// Sensor-mount sensitivity sweeps: run (sharded, resumable), merge, plot, report.
+    Sweep(sweep::Args),
     /// Benchmarks that print one JSON object.
     #[command(subcommand)]
     Bench(bench::Command),
@@ -61,6 +65,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Classify(a) => classify::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Train(a) => train::run(a),
+        Command::Sweep(a) => sweep::run(a),
         Command::Bench(c) => bench::run(c),
     }
 }

@@ -1,0 +1,325 @@
+//! The configuration space of a sweep: the product scenes x seeds x rigs x every parameter axis,
+//! numbered `0 .. count` in mixed radix (the last axis varies fastest), decoded on demand so
+//! nothing proportional to the count is held in memory.
+//!
+//! A configuration's parameters are applied to its rig:
+//! - `body = "<sensor>"`: the mount values replace that sensor's `mount` fields (absolute, as in
+//!   the manifest) and the sensor values its `spec` fields;
+//! - `body = "rig"` (default): the whole rig moves as one rigid body. Its reference point is the
+//!   mean of the sensors' mount positions (`lux-roof-4`: x 1.6, y 0, z 1.6); `x_m y_m z_m` place that
+//!   point (absolute, vehicle frame) and `roll_deg pitch_deg yaw_deg` turn the body about it,
+//!   relative to the rig as designed (0 = as mounted; +pitch tilts every sensor down), so the
+//!   sensors keep their relative poses. Sensor values apply to every sensor.
+//!
+//! Every configuration has a key: the [`stable_key`] of its canonical description (scene, seed,
+//! rig, frames, speed, ideal, body and every parameter value), the same sharded or not, on any
+//! machine.
+
+use anyhow::{Context, bail};
+use glam::{EulerRot, Quat, Vec3};
+use sim::Rig;
+
+use super::config::{MAX_CONFIGURATIONS, Sweep};
+use crate::cli::shard::stable_key;
+
+/// A validated sweep with its rigs loaded: the configuration space.
+pub struct Space {
+    /// The sweep.
+    pub sweep: Sweep,
+    /// The base rig of each `sweep.rigs` entry.
+    pub rigs: Vec<Rig>,
+    /// Number of values of each axis (mount, then sensor), for decoding.
+    radix: Vec<u64>,
+    /// Configurations per (scene, seed) group.
+    pub group_size: u64,
+    /// Number of configurations.
+    pub count: u64,
+}
+
+/// One configuration, decoded from its index.
+#[derive(Clone, Debug)]
+pub struct Configuration {
+    /// Its index in the space.
+    pub index: u64,
+    /// Index into `sweep.scenes`.
+    pub scene: usize,
+    /// Index into `sweep.seeds`.
+    pub seed: usize,
+    /// Index into `sweep.rigs`.
+    pub rig: usize,
+    /// Value index of each axis.
+    pub values: Vec<usize>,
+}
+
+impl Space {
+    /// Checks every name and value of `sweep` and counts the product; more than
+    /// [`MAX_CONFIGURATIONS`] is refused unless `allow_large`.
+    pub fn new(sweep: Sweep, allow_large: bool) -> anyhow::Result<Space> {
+        let known = crate::cli::common::scene_names();
+        for s in &sweep.scenes {
+            let is_file = s.ends_with(".toml");
+            if is_file && !std::path::Path::new(s).is_file() {
+                bail!("scenes: `{s}`: no such scene file");
+            }
+            if !is_file && !known.contains(s) && s != crate::cli::common::FIXTURE_TERRAIN {
+                bail!("scenes: unknown scene `{s}`; known: {} (or a .toml scene file)", known.join(", "));
+            }
+        }
+        let rigs = sweep
+            .rigs
+            .iter()
+            .map(|r| crate::cli::common::load_rig(r).with_context(|| format!("rigs: `{r}`")))
+            .collect::<anyhow::Result<Vec<Rig>>>()?;
+        for m in &sweep.methods {
+            classifier::method_by_name(m, 0).with_context(|| format!("methods: `{m}`"))?;
+        }
+        if sweep.body != "rig" {
+            for (name, rig) in sweep.rigs.iter().zip(&rigs) {
+                if !rig.sensors.iter().any(|s| s.name == sweep.body) {
+                    let names: Vec<&str> = rig.sensors.iter().map(|s| s.name.as_str()).collect();
+                    bail!(
+                        "body: rig `{name}` has no sensor `{}`; its sensors: {} (or \"rig\")",
+                        sweep.body,
+                        names.join(", ")
+                    );
+                }
+            }
+        }
+        let radix: Vec<u64> = sweep.axes().map(|a| a.values.len() as u64).collect();
+        let too_many = || {
+            anyhow::anyhow!(
+                "the sweep's product exceeds {MAX_CONFIGURATIONS} configurations; narrow it or pass --allow-large"
+            )
+        };
+        let group_size =
+            radix.iter().try_fold(sweep.rigs.len() as u64, |a, &n| a.checked_mul(n)).ok_or_else(too_many)?;
+        let count = group_size
+            .checked_mul(sweep.scenes.len() as u64)
+            .and_then(|c| c.checked_mul(sweep.seeds.len() as u64))
+            .ok_or_else(too_many)?;
+        if count > MAX_CONFIGURATIONS && !allow_large {
+            bail!(
+                "the sweep's product is {count} configurations (scenes x seeds x rigs x parameter values), over \
+                 {MAX_CONFIGURATIONS}; narrow it or pass --allow-large"
+            );
+        }
+        let space = Space { sweep, rigs, radix, group_size, count };
+        // Each value applied alone to each rig must give a valid rig (e.g. z_m within +-100 m,
+        // LUX frequency 12.5 / 25 / 50 Hz, a spec field the model has).
+        for (r, rig) in space.rigs.iter().enumerate() {
+            for (a, axis) in space.sweep.axes().enumerate() {
+                for k in 0..axis.values.len() {
+                    let mut values: Vec<Option<usize>> = vec![None; space.radix.len()];
+                    values[a] = Some(k);
+                    space.apply(rig, &values).with_context(|| {
+                        format!("`{}` = {} on rig `{}`", axis.name, axis.values[k], space.sweep.rigs[r])
+                    })?;
+                }
+            }
+        }
+        Ok(space)
+    }
+
+    /// Number of (scene, seed) groups.
+    pub fn groups(&self) -> u64 {
+        (self.sweep.scenes.len() * self.sweep.seeds.len()) as u64
+    }
+
+    /// Decodes configuration `index` (< `count`).
+    pub fn decode(&self, index: u64) -> Configuration {
+        let group = index / self.group_size;
+        let mut rest = index % self.group_size;
+        let mut values = vec![0usize; self.radix.len()];
+        for (v, &n) in values.iter_mut().zip(&self.radix).rev() {
+            *v = (rest % n) as usize;
+            rest /= n;
+        }
+        let seeds = self.sweep.seeds.len() as u64;
+        Configuration {
+            index,
+            scene: (group / seeds) as usize,
+            seed: (group % seeds) as usize,
+            rig: rest as usize,
+            values,
+        }
+    }
+
+    /// The configuration's parameters as `(column, value)` pairs, in column order.
+    pub fn params<'s>(&'s self, c: &Configuration) -> impl Iterator<Item = (&'s str, &'s serde_json::Value)> {
+        self.sweep.axes().zip(c.values.clone()).map(|(a, k)| (a.name.as_str(), &a.values[k]))
+    }
+
+    /// The configuration's stable key.
+    pub fn key(&self, c: &Configuration) -> String {
+        let s = &self.sweep;
+        let mut text = format!(
+            "scene={};seed={};rig={};frames={};speed_m_per_s={};ideal={};body={}",
+            s.scenes[c.scene], s.seeds[c.seed], s.rigs[c.rig], s.frames, s.speed_m_per_s, s.ideal, s.body
+        );
+        for (name, v) in self.params(c) {
+            text.push_str(&format!(";{name}={v}"));
+        }
+        stable_key(&text)
+    }
+
+    /// The rig of configuration `c`.
+    pub fn rig(&self, c: &Configuration) -> anyhow::Result<Rig> {
+        let values: Vec<Option<usize>> = c.values.iter().map(|&k| Some(k)).collect();
+        self.apply(&self.rigs[c.rig], &values)
+    }
+
+    /// `base` with the given axis values (`None`: left as designed) applied, validated.
+    fn apply(&self, base: &Rig, values: &[Option<usize>]) -> anyhow::Result<Rig> {
+        let mut rig = base.clone();
+        let mut mount = [None::<f32>; 6];
+        let mut sensor: Vec<(&str, &serde_json::Value)> = Vec::new();
+        for (axis, k) in self.sweep.axes().zip(values) {
+            let Some(k) = *k else { continue };
+            let v = &axis.values[k];
+            if let Some(p) = super::config::MOUNT_PARAMS.iter().position(|&m| m == axis.name) {
+                mount[p] = Some(v.as_f64().context("mount values are numbers")? as f32);
+            } else {
+                sensor.push((axis.name.trim_start_matches("sensor."), v));
+            }
+        }
+        let targets: Vec<usize> = if self.sweep.body == "rig" {
+            move_body(&mut rig, mount);
+            (0..rig.sensors.len()).collect()
+        } else {
+            let i = rig.sensors.iter().position(|s| s.name == self.sweep.body).context("body sensor")?;
+            let m = &mut rig.sensors[i].mount;
+            for (field, v) in [&mut m.x_m, &mut m.y_m, &mut m.z_m, &mut m.roll_deg, &mut m.pitch_deg, &mut m.yaw_deg]
+                .into_iter()
+                .zip(mount)
+            {
+                if let Some(v) = v {
+                    *field = v;
+                }
+            }
+            vec![i]
+        };
+        if !sensor.is_empty() {
+            for &i in &targets {
+                let s = &mut rig.sensors[i];
+                let mut spec = serde_json::to_value(&s.spec).context("sensor spec as JSON")?;
+                for &(field, v) in &sensor {
+                    set_path(&mut spec, field, v.clone());
+                }
+                s.spec = serde_json::from_value(spec).with_context(|| {
+                    format!("sensor `{}` ({}): not a parameter of its model", s.name, s.spec.model_name())
+                })?;
+            }
+        }
+        rig.validate().map_err(anyhow::Error::from)?;
+        Ok(rig)
+    }
+}
+
+/// Sets `spec.a.b.c = v`, creating tables on the way.
+fn set_path(spec: &mut serde_json::Value, path: &str, v: serde_json::Value) {
+    let mut node = spec;
+    let parts: Vec<&str> = path.split('.').collect();
+    for (i, p) in parts.iter().enumerate() {
+        if !node.is_object() {
+            *node = serde_json::json!({});
+        }
+        let obj = node.as_object_mut().expect("an object");
+        if i + 1 == parts.len() {
+            obj.insert(p.to_string(), v);
+            return;
+        }
+        node = obj.entry(p.to_string()).or_insert_with(|| serde_json::json!({}));
+    }
+}
+
+/// Moves the whole rig as one body (see the module doc): `mount` holds the new reference point
+/// (x, y, z; `None` keeps it) and the body's roll, pitch, yaw relative to the design.
+fn move_body(rig: &mut Rig, mount: [Option<f32>; 6]) {
+    let n = rig.sensors.len().max(1) as f32;
+    let origin =
+        rig.sensors.iter().map(|s| Vec3::new(s.mount.x_m, s.mount.y_m, s.mount.z_m)).fold(Vec3::ZERO, |a, b| a + b) / n;
+    let target = Vec3::new(mount[0].unwrap_or(origin.x), mount[1].unwrap_or(origin.y), mount[2].unwrap_or(origin.z));
+    let (roll, pitch, yaw) = (mount[3].unwrap_or(0.0), mount[4].unwrap_or(0.0), mount[5].unwrap_or(0.0));
+    let turned = roll != 0.0 || pitch != 0.0 || yaw != 0.0;
+    let body = Quat::from_euler(EulerRot::ZYX, yaw.to_radians(), pitch.to_radians(), roll.to_radians());
+    for s in &mut rig.sensors {
+        let m = &mut s.mount;
+        let p = Vec3::new(m.x_m, m.y_m, m.z_m) - origin;
+        let p = target + if turned { body * p } else { p };
+        (m.x_m, m.y_m, m.z_m) = (p.x, p.y, p.z);
+        if turned {
+            let q = body
+                * Quat::from_euler(
+                    EulerRot::ZYX,
+                    m.yaw_deg.to_radians(),
+                    m.pitch_deg.to_radians(),
+                    m.roll_deg.to_radians(),
+                );
+            let (z, y, x) = q.to_euler(EulerRot::ZYX);
+            (m.yaw_deg, m.pitch_deg, m.roll_deg) = (z.to_degrees(), y.to_degrees(), x.to_degrees());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn space(extra: &str) -> Space {
+        let text = format!(
+            "scenes = [\"city\", \"flat\"]\nrigs = [\"lux-roof-4\"]\nseeds = [0, 1]\nmethods = [\"nitsch\"]\n{extra}"
+        );
+        Space::new(Sweep::parse(&text, "t").unwrap(), false).unwrap()
+    }
+
+    #[test]
+    fn decode_covers_the_product_in_mixed_radix() {
+        let s = space("[mount]\nz_m = [1.2, 1.6, 2.0]\npitch_deg = [-2.0, 0.0]\n");
+        assert_eq!(s.count, 2 * 2 * 3 * 2);
+        assert_eq!(s.group_size, 6);
+        let c = s.decode(7);
+        assert_eq!((c.scene, c.seed, c.rig, c.values.clone()), (0, 1, 0, vec![0, 1]));
+        let keys: std::collections::HashSet<String> = (0..s.count).map(|i| s.key(&s.decode(i))).collect();
+        assert_eq!(keys.len() as u64, s.count);
+    }
+
+    #[test]
+    fn the_rig_moves_as_one_body() {
+        let s = space("[mount]\nz_m = [2.0]\npitch_deg = [2.0]\n");
+        let rig = s.rig(&s.decode(0)).unwrap();
+        // Reference point (1.6, 0, 1.6) lifted to z 2.0; every sensor pitched 2 deg further down.
+        let base = Rig::preset("lux-roof-4").unwrap();
+        for (a, b) in rig.sensors.iter().zip(&base.sensors) {
+            assert!((a.mount.pitch_deg - (b.mount.pitch_deg + 2.0)).abs() < 1e-4, "{:?}", a.mount);
+            assert!(a.mount.roll_deg.abs() < 1e-4 && a.mount.yaw_deg.abs() < 1e-4);
+        }
+        let mean_z: f32 = rig.sensors.iter().map(|s| s.mount.z_m).sum::<f32>() / 4.0;
+        assert!((mean_z - 2.0).abs() < 1e-5, "{mean_z}");
+        // Height only: positions shift, angles are kept exactly.
+        let s = space("[mount]\nz_m = [1.2]\n");
+        let rig = s.rig(&s.decode(0)).unwrap();
+        assert_eq!(rig.sensors[2].mount.pitch_deg, 7.2);
+        assert!((rig.sensors[2].mount.z_m - 1.2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn bad_values_and_products_are_refused() {
+        let bad = |extra: &str, needle: &str| {
+            let text =
+                format!("scenes = [\"city\"]\nrigs = [\"lux-roof-4\"]\nseeds = [0]\nmethods = [\"nitsch\"]\n{extra}");
+            let e = match Sweep::parse(&text, "t").and_then(|s| Space::new(s, false)) {
+                Ok(_) => panic!("{extra} accepted"),
+                Err(e) => format!("{e:#}"),
+            };
+            assert!(e.contains(needle), "{extra}: {e}");
+        };
+        bad("[mount]\nz_m = [200.0]\n", "z_m");
+        bad("[sensor]\nfrequency_hz = [13.0]\n", "frequency_hz");
+        bad("[sensor]\ncolumns = [1024]\n", "columns");
+        bad("body = \"roof_9\"\n", "roof_9");
+        bad(
+            "[mount]\nx_m = { from = 0, to = 99 }\ny_m = { from = 0, to = 99 }\nz_m = { from = 0, to = 99 }\nyaw_deg = { from = 0, to = 99 }\n",
+            "--allow-large",
+        );
+    }
+}

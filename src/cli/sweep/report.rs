@@ -1,0 +1,10 @@
+//! `groundtruth sweep report`: not implemented yet.
+
+/// Arguments.
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+/// Refuses: not implemented yet.
+pub fn run(_a: Args) -> anyhow::Result<()> {
+    anyhow::bail!("sweep report: not implemented yet")
+}
