@@ -177,25 +177,52 @@ pub fn tree(
     trunk_radius_m: f32,
     crown_radius_m: f32,
 ) -> u32 {
+    let shape = TreeShape {
+        crown_base_m: trunk_height_m,
+        trunk_radius_m,
+        crown_radius_m,
+        crown_half_height_m: 0.8 * crown_radius_m,
+    };
+    shaped_tree(mesh, ids, base, &shape)
+}
+
+/// The shape of a broadleaf tree for [`shaped_tree`], metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeShape {
+    /// Height of the crown's bottom (the bare trunk) above the ground point.
+    pub crown_base_m: f32,
+    /// Trunk radius.
+    pub trunk_radius_m: f32,
+    /// Horizontal radius of the ellipsoid crown.
+    pub crown_radius_m: f32,
+    /// Vertical semi-axis of the crown (its height is twice this).
+    pub crown_half_height_m: f32,
+}
+
+/// A tree of `shape`: an 8-sided trunk (class trunk) from 0.3 m below the ground point up into the
+/// crown (to half the crown's lower half), and an ellipsoid crown (class vegetation, 6 x 10
+/// facets) whose bottom is `crown_base_m` above the ground point; one instance.
+pub fn shaped_tree(mesh: &mut SceneMesh, ids: &mut Ids, base: Vec3, shape: &TreeShape) -> u32 {
     let id = ids.fresh();
     let at = pose(base, 0.0);
-    let crown_half_height = 0.8 * crown_radius_m;
+    let TreeShape { crown_base_m, trunk_radius_m, crown_radius_m, crown_half_height_m } = *shape;
     push_prism(
         mesh,
         at,
         8,
         trunk_radius_m,
-        (-0.3, trunk_height_m + 0.5 * crown_half_height),
+        (-0.3, crown_base_m + 0.5 * crown_half_height_m),
         Surface::object(SemanticClass::TRUNK, id),
     );
-    let c = Vec3::new(0.0, 0.0, trunk_height_m + crown_half_height);
-    let r = Vec3::new(crown_radius_m, crown_radius_m, crown_half_height);
+    let c = Vec3::new(0.0, 0.0, crown_base_m + crown_half_height_m);
+    let r = Vec3::new(crown_radius_m, crown_radius_m, crown_half_height_m);
     push_ellipsoid(mesh, at, c, r, (6, 10), Surface::object(SemanticClass::VEGETATION, id));
     id
 }
 
-/// A bush or shrub (class vegetation): an ellipsoid of radius `radius_m` and height `height_m`,
-/// sunk 20 % into the ground so it meets uneven terrain.
+/// A bush or shrub (class bush, 73: bushes and shrubs are their own class, apart from tree canopy;
+/// see [`sim::SemanticClass::BUSH`]): an ellipsoid of radius `radius_m` and height `height_m`, sunk
+/// 20 % into the ground so it meets uneven terrain.
 pub fn bush(mesh: &mut SceneMesh, ids: &mut Ids, base: Vec3, radius_m: f32, height_m: f32) -> u32 {
     let id = ids.fresh();
     let half = 0.5 * height_m / 0.8;
@@ -206,7 +233,7 @@ pub fn bush(mesh: &mut SceneMesh, ids: &mut Ids, base: Vec3, radius_m: f32, heig
         c,
         Vec3::new(radius_m, radius_m, half),
         (4, 8),
-        Surface::object(SemanticClass::VEGETATION, id),
+        Surface::object(SemanticClass::BUSH, id),
     );
     id
 }

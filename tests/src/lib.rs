@@ -1,6 +1,7 @@
 //! Shared helpers of the scenario tests in `tests/tests/`: scan a bundled scene with a rig and
 //! classify it, returning the clouds, decisions and scores.
 
+pub mod forests;
 pub mod real_files;
 
 use classifier::{Evaluation, FrameInput, method_by_name};

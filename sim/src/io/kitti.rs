@@ -1,7 +1,8 @@
 //! KITTI / SemanticKITTI files: `frame_NNNNNN.bin` (float32 `x y z intensity` per return, in scan
 //! order as a real HDL-64E's KITTI files are: see [`scan_order`]), `frame_NNNNNN.label` (uint32
 //! per return: semantic class in the low 16 bits,
-//! instance id in the high 16 bits; instance ids above 65535 keep their low 16 bits) and, for a
+//! instance id in the high 16 bits; instance ids above 65535 keep their low 16 bits; the class is
+//! `SemanticClass::semantic_kitti_id`, so our bush class 73 is written as 70 vegetation) and, for a
 //! single-sensor rig, `frame_NNNNNN.calib.txt` with one line `Tr: r00 r01 r02 t0 r10 ... t2`, the
 //! 3 x 4 row-major `vehicle_from_sensor` transform (points in the `.bin` are then in the sensor
 //! frame, as KITTI's are; multiply by `Tr` to get vehicle-frame points). Intensity is in `[0, 1]`.
@@ -49,7 +50,7 @@ pub fn encode(cloud: &OrderedCloud, sensor_from_vehicle: Option<&Affine3A>) -> R
         rec[8..12].copy_from_slice(&p.z.to_le_bytes());
         rec[12..16].copy_from_slice(&cloud.intensity[i].clamp(0.0, 1.0).to_le_bytes());
         bin.extend_from_slice(&rec);
-        let l = u32::from(cloud.label[i].0) | ((cloud.instance[i] & 0xFFFF) << 16);
+        let l = u32::from(cloud.label[i].semantic_kitti_id()) | ((cloud.instance[i] & 0xFFFF) << 16);
         label.extend_from_slice(&l.to_le_bytes());
     }
     Ok((bin, label, n))

@@ -8,13 +8,14 @@
 //!   across echo planes);
 //! - `gps_time`: the point's time in seconds since the start of the scan (not GPS week seconds:
 //!   the global encoding leaves "standard GPS time" unset);
-//! - `classification` (ASPRS), see [`asprs_class`]: ground truth ground = 2, vegetation and
-//!   trunk = 5 (high vegetation; bushes and canopy are not told apart), building = 6, and
-//!   user-definable classes 64.. for the rest: car 64, truck 65, other-vehicle 66, person 67,
-//!   fence 68, other-structure 69, pole 70, traffic-sign 71, other-object 72; anything else
-//!   (including unlabeled returns) = 1 (unclassified);
-//! - `user_data`: our SemanticKITTI class id (clamped to 255, so SemanticKITTI's moving classes
-//!   252-259 all read 255);
+//! - `classification` (ASPRS), see [`asprs_class`] and [`SemanticClass::las_class`]: ground truth
+//!   ground = 2, bushes and shrubs (our class 73) = 4 (medium vegetation), canopy (vegetation 70)
+//!   and trunk = 5 (high vegetation), building = 6, and user-definable classes 64.. for the rest:
+//!   car 64, truck 65, other-vehicle 66, person 67, fence 68, other-structure 69, pole 70,
+//!   traffic-sign 71, other-object 72; anything else (including unlabeled returns) = 1
+//!   (unclassified);
+//! - `user_data`: our class id (73 for bushes, not mapped; clamped to 255, so SemanticKITTI's
+//!   moving classes 252-259 all read 255);
 //! - `point_source_id`: the ring; `scanner_channel`: the sensor id when below 4, else 3;
 //! - one extra-bytes field `instance` (uint32, described by a LASF_Spec record 4 VLR, which
 //!   laspy and PDAL read as a named dimension).
@@ -35,26 +36,10 @@ pub const SCALE_M: f64 = 0.0001;
 /// Bytes per point record: format 6 (30 bytes) plus the 4-byte `instance` extra field.
 const RECORD_BYTES: usize = 34;
 
-/// The ASPRS classification of a return with SemanticKITTI class `label` and ground truth flag
-/// `ground` (see the module docs for the table).
+/// The ASPRS classification of a return with class `label` and ground truth flag `ground`: 2
+/// when `ground`, else [`SemanticClass::las_class`] (see the module docs for the table).
 pub fn asprs_class(label: SemanticClass, ground: bool) -> u8 {
-    if ground {
-        return 2;
-    }
-    match label.0 {
-        70 | 71 => 5,
-        50 => 6,
-        10 => 64,
-        18 => 65,
-        20 => 66,
-        30 => 67,
-        51 => 68,
-        52 => 69,
-        80 => 70,
-        81 => 71,
-        99 => 72,
-        _ => 1,
-    }
+    if ground { 2 } else { label.las_class() }
 }
 
 /// The 192-byte extra-bytes descriptor of the `instance` field (LAS 1.4 table 24).

@@ -1,4 +1,16 @@
-//! Semantic classes, using the SemanticKITTI label ids.
+//! Semantic classes, using the SemanticKITTI label ids, plus one of our own:
+//!
+//! | id | name | what | SemanticKITTI `.label` | LAS (ASPRS) |
+//! |----|------|------|------------------------|-------------|
+//! | 70 | vegetation | tree canopy (branches and leaves) | 70 vegetation | 5 high vegetation |
+//! | 71 | trunk | tree trunks | 71 trunk | 5 high vegetation |
+//! | 73 | bush | bushes and shrubs (ours: seed 002 counts them apart from the canopy) | 70 vegetation | 4 medium vegetation |
+//!
+//! SemanticKITTI has no bush class (its "vegetation" holds canopy and bushes alike), so the id 73,
+//! unused in its label config, is ours. Our own ordered formats (PCD, PLY) keep 73; the KITTI
+//! `.label` writer writes [`SemanticClass::semantic_kitti_id`] (73 -> 70), so the standard
+//! SemanticKITTI tools and label configs read our files, and the LAS writer writes
+//! [`SemanticClass::las_class`] (bushes 4, canopy and trunks 5).
 
 use serde::{Deserialize, Serialize};
 
@@ -34,12 +46,16 @@ impl SemanticClass {
     pub const OTHER_STRUCTURE: Self = Self(52);
     /// Lane marking.
     pub const LANE_MARKING: Self = Self(60);
-    /// Vegetation (canopy, bushes).
+    /// Vegetation: tree canopy, branches and leaves (SemanticKITTI's class also holds bushes; ours
+    /// has [`Self::BUSH`] for those).
     pub const VEGETATION: Self = Self(70);
     /// Trunk.
     pub const TRUNK: Self = Self(71);
     /// Terrain.
     pub const TERRAIN: Self = Self(72);
+    /// Bushes and shrubs (73, not a SemanticKITTI id: written as 70 vegetation to KITTI `.label`
+    /// files, as 4 medium vegetation to LAS; see the module docs).
+    pub const BUSH: Self = Self(73);
     /// Pole.
     pub const POLE: Self = Self(80);
     /// Traffic sign.
@@ -56,7 +72,42 @@ impl SemanticClass {
         Self::GROUND.contains(&self)
     }
 
-    /// The SemanticKITTI name of the class, or `"other"`.
+    /// The id a SemanticKITTI `.label` file holds for this class: the class itself, except our
+    /// [`Self::BUSH`] (73), which SemanticKITTI counts as 70 vegetation.
+    pub fn semantic_kitti_id(self) -> u16 {
+        match self {
+            Self::BUSH => Self::VEGETATION.0,
+            c => c.0,
+        }
+    }
+
+    /// The nearest ASPRS (LAS 1.4) classification: ground classes 2 (ground), bushes 4 (medium
+    /// vegetation), canopy and trunks 5 (high vegetation), building 6, and the user-definable
+    /// classes 64.. for the rest: car 64, truck 65, other-vehicle 66, person 67, fence 68,
+    /// other-structure 69, pole 70, traffic-sign 71, other-object 72; anything else (unlabeled
+    /// included) 1 (unclassified).
+    pub fn las_class(self) -> u8 {
+        if self.is_ground() {
+            return 2;
+        }
+        match self.0 {
+            73 => 4,
+            70 | 71 => 5,
+            50 => 6,
+            10 => 64,
+            18 => 65,
+            20 => 66,
+            30 => 67,
+            51 => 68,
+            52 => 69,
+            80 => 70,
+            81 => 71,
+            99 => 72,
+            _ => 1,
+        }
+    }
+
+    /// The SemanticKITTI name of the class (ours for [`Self::BUSH`]: `"bush"`), or `"other"`.
     pub fn name(self) -> &'static str {
         match self.0 {
             0 => "unlabeled",
@@ -75,6 +126,7 @@ impl SemanticClass {
             70 => "vegetation",
             71 => "trunk",
             72 => "terrain",
+            73 => "bush",
             80 => "pole",
             81 => "traffic-sign",
             99 => "other-object",
@@ -100,6 +152,8 @@ impl SemanticClass {
             70 => [0, 175, 0],
             71 => [135, 60, 0],
             72 => [150, 240, 80],
+            // Bushes: a blue-green apart from canopy green and terrain (seed 002 draws them blue).
+            73 => [0, 120, 160],
             80 => [255, 240, 150],
             81 => [255, 0, 0],
             _ => [128, 128, 128],
@@ -115,5 +169,22 @@ mod tests {
     fn ground_set_is_the_six_ground_classes() {
         let ground: Vec<u16> = (0..=u16::from(u8::MAX)).filter(|&id| SemanticClass(id).is_ground()).collect();
         assert_eq!(ground, vec![40, 44, 48, 49, 60, 72]);
+    }
+
+    #[test]
+    fn bush_is_ours_and_maps_to_vegetation_in_kitti_and_medium_vegetation_in_las() {
+        assert_eq!((SemanticClass::BUSH.0, SemanticClass::BUSH.name()), (73, "bush"));
+        assert_eq!(SemanticClass::BUSH.semantic_kitti_id(), 70);
+        assert_eq!(SemanticClass::VEGETATION.semantic_kitti_id(), 70);
+        assert_eq!(SemanticClass::TRUNK.semantic_kitti_id(), 71);
+        assert_eq!(SemanticClass::CAR.semantic_kitti_id(), 10);
+        assert_eq!(SemanticClass::BUSH.las_class(), 4);
+        assert_eq!(SemanticClass::VEGETATION.las_class(), 5);
+        assert_eq!(SemanticClass::TRUNK.las_class(), 5);
+        assert_eq!(SemanticClass::TERRAIN.las_class(), 2);
+        assert_eq!(SemanticClass::UNLABELED.las_class(), 1);
+        let colours: std::collections::BTreeSet<[u8; 3]> =
+            [70, 71, 72, 73].map(|id| SemanticClass(id).color()).into_iter().collect();
+        assert_eq!(colours.len(), 4, "vegetation, trunk, terrain and bush are told apart in pictures");
     }
 }
