@@ -136,7 +136,7 @@ fn organized_top_first_or_without_ring_gives_the_bottom_first_decisions() {
         top.ring[k * cols..(k + 1) * cols].fill(k as u16);
     }
     for has_ring in [true, false] {
-        let (ordered, report) = order_organized(&top, has_ring, Affine3A::IDENTITY).unwrap();
+        let (ordered, report) = order_organized(top.clone(), has_ring, Affine3A::IDENTITY).unwrap();
         assert_eq!(report.path, OrderingPath::Organized);
         let d = decisions_per_point(&report, &m.classify(&ordered).unwrap());
         for k in 0..rows {
@@ -149,11 +149,11 @@ fn organized_top_first_or_without_ring_gives_the_bottom_first_decisions() {
     // A ring value out of range, or two rows of one ring: refused.
     let mut bad = top.clone();
     bad.ring[..cols].fill(rows as u16);
-    let e = order_organized(&bad, true, Affine3A::IDENTITY).unwrap_err().to_string();
+    let e = order_organized(bad, true, Affine3A::IDENTITY).unwrap_err().to_string();
     assert!(e.contains("out of range"), "{e}");
     let mut twice = top.clone();
     twice.ring[..cols].fill(1);
-    assert!(order_organized(&twice, true, Affine3A::IDENTITY).unwrap_err().to_string().contains("more than one row"));
+    assert!(order_organized(twice, true, Affine3A::IDENTITY).unwrap_err().to_string().contains("more than one row"));
     // No way up to tell: every row the same.
     let mut flat = top.clone();
     let fullest = (0..rows)
@@ -163,6 +163,6 @@ fn organized_top_first_or_without_ring_gives_the_bottom_first_decisions() {
     for k in 1..rows {
         flat.point_in_vehicle[k * cols..(k + 1) * cols].copy_from_slice(&row0);
     }
-    let e = order_organized(&flat, false, Affine3A::IDENTITY).unwrap_err().to_string();
+    let e = order_organized(flat, false, Affine3A::IDENTITY).unwrap_err().to_string();
     assert!(e.contains("cannot tell"), "{e}");
 }

@@ -208,7 +208,7 @@ pub(crate) fn read_frame_timed(path: &Path, setup: &SensorSetup) -> anyhow::Resu
                 {
                     bail!("`{}` has {} rows but the calibration file {n} lasers", path.display(), cloud.rows);
                 }
-                let (cloud, report) = order_organized(&cloud, info.has_ring, setup.vehicle_from_sensor)
+                let (cloud, report) = order_organized(cloud, info.has_ring, setup.vehicle_from_sensor)
                     .with_context(|| format!("ordering the rows of `{}`", path.display()))?;
                 return Ok((ReadFrame { cloud, report: Some(report) }, read_ms));
             }

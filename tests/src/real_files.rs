@@ -147,8 +147,8 @@ pub fn layout_agreement(scene: &str, rig: &str, seed: u64, method: &str) -> Vec<
                 let d = classify(&read);
                 (d.iter().map(|&g| u8::from(g)).collect::<Vec<u8>>(), "ours: as written".to_string())
             } else {
-                let (ordered, report) =
-                    order_organized(&read, info.has_ring && with_ring, vehicle_from_sensor).expect("order organized");
+                let (ordered, report) = order_organized(read.clone(), info.has_ring && with_ring, vehicle_from_sensor)
+                    .expect("order organized");
                 (decisions_per_point(&report, &classify(&ordered)), report.summary())
             };
             // File cell -> grid cell of the scan.

@@ -30,11 +30,11 @@ pub const SAME_SURFACE: f32 = 0.2;
 /// normals) go to the vehicle frame through `vehicle_from_sensor`; ranges stay the file's (or the
 /// distance from the file's origin where it has none).
 pub fn order_organized(
-    cloud: &OrderedCloud,
+    cloud: OrderedCloud,
     has_ring: bool,
     vehicle_from_sensor: glam::Affine3A,
 ) -> Result<(OrderedCloud, OrderingReport)> {
-    crate::error::check_cloud(cloud)?;
+    crate::error::check_cloud(&cloud)?;
     let (rows, cols) = (cloud.rows, cloud.cols);
     if cloud.planes != 1 {
         return Err(ClassifyError::Ordering(format!(
@@ -112,13 +112,9 @@ pub fn order_organized(
         )));
     };
     let new_row: Vec<usize> = ring_of_row.iter().map(|&g| if bottom_first { g } else { rows - 1 - g }).collect();
-    let mut out = cloud.clone();
+    let mut out = cloud;
     macro_rules! permute {
-        ($($f:ident),*) => {$(
-            for (k, &r) in new_row.iter().enumerate() {
-                out.$f[r * cols..(r + 1) * cols].copy_from_slice(&cloud.$f[k * cols..(k + 1) * cols]);
-            }
-        )*};
+        ($($f:ident),*) => {$( permute_rows(&mut out.$f, cols, &new_row); )*};
     }
     permute!(point_in_vehicle, range_m, intensity, ring, column, sensor, time_s, echo, label, instance, ground, normal);
     if vehicle_from_sensor != glam::Affine3A::IDENTITY {
@@ -139,7 +135,7 @@ pub fn order_organized(
             report.cell_of_point.push(Some((r * cols + c) as u32));
         }
     }
-    report.placed = cloud.returns();
+    report.placed = out.returns();
     report.no_returns = rows * cols - report.placed;
     report.rings_found = rings_with_returns;
     Ok((out, report))
@@ -148,4 +144,31 @@ pub fn order_organized(
 /// Whether [`order_organized`] found the file top-first: its first row went to the top.
 pub fn is_top_first(report: &OrderingReport, rows: usize, cols: usize) -> bool {
     rows > 1 && report.cell_of_point.first().copied().flatten().is_some_and(|c| c as usize / cols.max(1) == rows - 1)
+}
+
+/// Moves row `k` of `v` (rows of `cols`) to row `new_row[k]`, in place (cycle by cycle, one row
+/// held aside).
+fn permute_rows<T: Copy>(v: &mut [T], cols: usize, new_row: &[usize]) {
+    let rows = new_row.len();
+    let mut done = vec![false; rows];
+    for start in 0..rows {
+        if done[start] {
+            continue;
+        }
+        done[start] = true;
+        if new_row[start] == start {
+            continue;
+        }
+        let mut held: Vec<T> = v[start * cols..(start + 1) * cols].to_vec();
+        let mut k = start;
+        loop {
+            let d = new_row[k];
+            held.swap_with_slice(&mut v[d * cols..(d + 1) * cols]);
+            done[d] = true;
+            if d == start {
+                break;
+            }
+            k = d;
+        }
+    }
 }

@@ -108,7 +108,10 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
             DataKind::Binary | DataKind::Compressed => {
                 let rec = &body[i * h.record_bytes..(i + 1) * h.record_bytes];
                 for (v, pos) in vals.iter_mut().zip(h.slots.iter()) {
-                    *v = pos.and_then(|p| p.scalar.decode(&rec[p.offset..], false)).unwrap_or(f64::NAN);
+                    *v = match pos {
+                        Some(p) => decode_le(p.scalar, &rec[p.offset..]),
+                        None => f64::NAN,
+                    };
                 }
             }
             DataKind::Ascii => {
@@ -168,4 +171,21 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
         }
     }
     Ok((cloud, info))
+}
+
+/// One little-endian value from the start of `b`, widened to `f64` (NaN if `b` is too short): the
+/// binary reader's inlined form of `Scalar::decode`.
+#[inline(always)]
+fn decode_le(s: Scalar, b: &[u8]) -> f64 {
+    let take4 = |b: &[u8]| b.get(..4).map(|x| [x[0], x[1], x[2], x[3]]);
+    match s {
+        Scalar::F(4) => take4(b).map_or(f64::NAN, |x| f64::from(f32::from_le_bytes(x))),
+        Scalar::U(4) => take4(b).map_or(f64::NAN, |x| f64::from(u32::from_le_bytes(x))),
+        Scalar::I(4) => take4(b).map_or(f64::NAN, |x| f64::from(i32::from_le_bytes(x))),
+        Scalar::U(2) => b.get(..2).map_or(f64::NAN, |x| f64::from(u16::from_le_bytes([x[0], x[1]]))),
+        Scalar::I(2) => b.get(..2).map_or(f64::NAN, |x| f64::from(i16::from_le_bytes([x[0], x[1]]))),
+        Scalar::U(1) => b.first().map_or(f64::NAN, |&x| f64::from(x)),
+        Scalar::I(1) => b.first().map_or(f64::NAN, |&x| f64::from(x as i8)),
+        other => other.decode(b, false).unwrap_or(f64::NAN),
+    }
 }
