@@ -93,6 +93,26 @@ fn sharded_and_merged_equals_unsharded_at_1_and_2_threads() {
     let first: serde_json::Value = serde_json::from_str(json.lines().next().unwrap()).unwrap();
     assert!(first["key"].as_str().unwrap().len() == 32 && first["f1"].is_number());
 
+    // Plots (a line per method with a band over the 2 seeds; a heat map) and the report.
+    let png = dir.path().join("f1.png");
+    ok(sweep(&["plot", s(&whole), "--x", "pitch_deg", "--metric", "f1", "--out", s(&png)]));
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert!(img.pixels().any(|p| p.0 == [31, 119, 180]) && img.pixels().any(|p| p.0 == [214, 39, 40]));
+    let svg = dir.path().join("heat.svg");
+    let args = ["plot", s(&whole), "--x", "pitch_deg", "--y", "z_m", "--metric", "recall", "--where", "method=nitsch"];
+    ok(sweep(&[&args[..], &["--out", s(&svg)]].concat()));
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("mount height z (m)"));
+    let e = err(sweep(&["plot", s(&whole), "--x", "height", "--metric", "f1", "--out", s(&png)]));
+    assert!(e.contains("not a swept parameter"), "{e}");
+    let e = err(sweep(&["plot", s(&whole), "--x", "z_m", "--metric", "speed", "--out", s(&png)]));
+    assert!(e.contains("not a metric"), "{e}");
+    ok(sweep(&["report", s(&whole)]));
+    let md = std::fs::read_to_string(whole.join("report.md")).unwrap();
+    for needle in ["| nitsch | best |", "| nitsch | worst |", "| ransac | best |", "plots/f1_vs_pitch_deg.png"] {
+        assert!(md.contains(needle), "{needle}: {md}");
+    }
+    assert!(whole.join("plots/f1_vs_pitch_deg.png").exists());
+
     for threads in ["1", "2"] {
         let shards: Vec<PathBuf> = (0..3).map(|i| dir.path().join(format!("shard{threads}-{i}"))).collect();
         for (i, d) in shards.iter().enumerate() {

@@ -179,7 +179,6 @@ pub fn write_rows(dir: &Path, header: &[String], found: &Found, keep: impl Fn(&s
 }
 
 /// Reads every row of a sweep directory's `results.jsonl` as JSON objects.
-#[allow(dead_code)] // used by `sweep plot` and `sweep report`, next
 pub fn read_rows(dir: &Path) -> anyhow::Result<Vec<serde_json::Map<String, Value>>> {
     let path = dir.join(JSONL_FILE);
     if !path.exists() {
