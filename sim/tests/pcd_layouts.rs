@@ -1,0 +1,104 @@
+//! The ROS drivers' organized PCD layouts (`sim::io::pcd::PcdLayout`): what each writes, and that
+//! the reader follows their conventions (top-first ouster rows, zero no-returns, millimetre
+//! `range`, nanosecond `t`) and refuses broken files naming them.
+
+use std::path::Path;
+
+use glam::{Affine3A, Vec3};
+use sim::OrderedCloud;
+use sim::io::pcd::{PcdLayout, encode_layout, read_bytes_with_info};
+use sim::scene::SemanticClass;
+
+/// 6 rows x 20 columns; every 5th cell without a return.
+fn cloud() -> OrderedCloud {
+    let (rows, cols) = (6, 20);
+    let mut c = OrderedCloud::empty(rows, cols, 1);
+    for row in 0..rows {
+        for col in 0..cols {
+            let i = row * cols + col;
+            c.ring[i] = row as u16;
+            c.time_s[i] = 0.5 + 1e-4 * col as f64;
+            if i % 5 == 2 {
+                continue;
+            }
+            let az = col as f32 * 0.3;
+            let p = Vec3::new((4.0 + row as f32) * az.cos(), (4.0 + row as f32) * az.sin(), -1.5 + 0.4 * row as f32);
+            c.point_in_vehicle[i] = p;
+            c.range_m[i] = p.length();
+            c.intensity[i] = 0.5;
+            c.label[i] = if row < 3 { SemanticClass::ROAD } else { SemanticClass::BUILDING };
+            c.ground[i] = row < 3;
+        }
+    }
+    c
+}
+
+#[test]
+fn layout_names_parse_and_unknown_ones_are_refused() {
+    for name in PcdLayout::NAMES {
+        assert_eq!(PcdLayout::parse(name).unwrap().name(), name);
+    }
+    let e = PcdLayout::parse("livox").unwrap_err().to_string();
+    assert!(e.contains("livox") && e.contains("groundtruth, velodyne, ouster"), "{e}");
+}
+
+#[test]
+fn velodyne_layout_is_bottom_first_with_nan_no_returns() {
+    let c = cloud();
+    let bytes = encode_layout(&c, PcdLayout::Velodyne, false, None).unwrap();
+    let text = String::from_utf8_lossy(&bytes[..300]).to_string();
+    assert!(text.contains("FIELDS x y z intensity ring time label\n"), "{text}");
+    assert!(text.contains("WIDTH 20\nHEIGHT 6\n") && !text.contains("groundtruth"), "{text}");
+    let (back, info) = read_bytes_with_info(Path::new("v.pcd"), &bytes).unwrap();
+    assert!(info.has_ring && info.organized && !info.ours && !info.range_in_mm);
+    assert_eq!(info.zero_cells, 0);
+    for i in 0..c.len() {
+        assert_eq!(back.ring[i], c.ring[i]);
+        assert_eq!(back.has_return(i), c.has_return(i), "cell {i}");
+        if c.has_return(i) {
+            assert_eq!(back.point_in_vehicle[i], c.point_in_vehicle[i]);
+            assert_eq!(back.label[i], c.label[i]);
+            assert!((back.time_s[i] - (c.time_s[i] - 0.5)).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn ouster_layout_is_top_first_with_zero_no_returns_and_millimetre_ranges() {
+    let c = cloud();
+    let (rows, cols) = (c.rows, c.cols);
+    // In the sensor frame, as the driver writes.
+    let sensor_from_vehicle = Affine3A::from_translation(Vec3::new(0.0, 0.0, -1.8));
+    let bytes = encode_layout(&c, PcdLayout::Ouster, false, Some(&sensor_from_vehicle)).unwrap();
+    let text = String::from_utf8_lossy(&bytes[..300]).to_string();
+    assert!(text.contains("FIELDS x y z intensity t reflectivity ring ambient range label\n"), "{text}");
+    assert!(text.contains("TYPE F F F F U U U U U U\n"), "{text}");
+    let (back, info) = read_bytes_with_info(Path::new("o.pcd"), &bytes).unwrap();
+    assert!(info.has_ring && info.range_in_mm && info.time_in_ns);
+    assert_eq!(info.zero_cells, c.len() - c.returns());
+    for k in 0..rows {
+        for col in 0..cols {
+            // File row k = ring k = grid row rows - 1 - k (the top beam first).
+            let (i, g) = (k * cols + col, (rows - 1 - k) * cols + col);
+            assert_eq!(back.ring[i], k as u16);
+            assert_eq!(back.has_return(i), c.has_return(g), "file cell {i}");
+            if c.has_return(g) {
+                let p = sensor_from_vehicle.transform_point3(c.point_in_vehicle[g]);
+                assert!((back.point_in_vehicle[i] - p).length() < 1e-5);
+                assert!((back.range_m[i] - c.range_m[g]).abs() <= 0.0005, "{} vs {}", back.range_m[i], c.range_m[g]);
+                assert!((back.time_s[i] - (c.time_s[g] - 0.5)).abs() < 1e-8);
+                assert_eq!(back.label[i], c.label[g]);
+            }
+        }
+    }
+}
+
+#[test]
+fn truncated_layout_files_are_refused_naming_the_file() {
+    let c = cloud();
+    for layout in [PcdLayout::Velodyne, PcdLayout::Ouster] {
+        let bytes = encode_layout(&c, layout, false, None).unwrap();
+        let e = read_bytes_with_info(Path::new("cut.pcd"), &bytes[..bytes.len() - 7]).unwrap_err().to_string();
+        assert!(e.contains("cut.pcd"), "{e}");
+    }
+}
