@@ -32,7 +32,7 @@ fn main() {
         .iter()
         .position(|a| a == "--max-iter")
         .and_then(|i| args.get(i + 1))
-        .map_or(100_000, |s| s.parse().expect("--max-iter N"));
+        .map_or(300_000, |s| s.parse().expect("--max-iter N"));
     let eps: f64 = args
         .iter()
         .position(|a| a == "--eps")

@@ -148,7 +148,7 @@ fn svm_agrees_with_liblinear_on_separable_and_noisy_data() {
         assert!((ours.bias - theirs.bias).abs() <= 0.03 * wn.max(1.0), "{what}: bias {} vs {}", ours.bias, theirs.bias);
     }
     // Overlapping classes at C = 100: LIBLINEAR stops at its 1000 passes far from converged; ours
-    // runs up to 100,000 passes, reaches an objective no worse, and predicts the same almost
+    // runs up to 300,000 passes, reaches an objective no worse, and predicts the same almost
     // everywhere.
     let (ours, _, same, o1, o2) = run(4.0, 100.0);
     eprintln!(
