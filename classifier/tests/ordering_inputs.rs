@@ -166,3 +166,35 @@ fn organized_top_first_or_without_ring_gives_the_bottom_first_decisions() {
     let e = order_organized(flat, false, Affine3A::IDENTITY).unwrap_err().to_string();
     assert!(e.contains("cannot tell"), "{e}");
 }
+
+#[test]
+fn ring_fields_give_rows_top_first_or_bottom_first_and_out_of_range_rings_are_refused() {
+    let (table, pts, truth) = kitti_like(360);
+    let n = pts.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    for k in (1..n).rev() {
+        order.swap(k, (k * 104_729 + 7) % (k + 1));
+    }
+    let shuffled: Vec<Vec3> = order.iter().map(|&k| pts[k]).collect();
+    for top_first in [true, false] {
+        // ouster-ros numbers rings from the top beam, velodyne from the bottom one.
+        let rings: Vec<u16> =
+            order.iter().map(|&k| if top_first { 15 - truth[k].0 as u16 } else { truth[k].0 as u16 }).collect();
+        let attrs = PointAttributes { rings: Some(&rings), ..PointAttributes::default() };
+        let (_, report) =
+            order_cloud(&shuffled, &attrs, &table, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default())
+                .unwrap();
+        assert_eq!(report.path, OrderingPath::RingField);
+        assert_eq!(report.rings_found, 16);
+        for (k, &o) in order.iter().enumerate() {
+            assert_eq!(report.cell_of_point[k], Some((truth[o].0 * 360 + truth[o].1) as u32), "point {k}");
+        }
+    }
+    let mut rings = vec![0u16; n];
+    rings[17] = 16;
+    let attrs = PointAttributes { rings: Some(&rings), ..PointAttributes::default() };
+    let e = order_cloud(&shuffled, &attrs, &table, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("ring 16, out of range"), "{e}");
+}

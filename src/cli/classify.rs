@@ -8,7 +8,8 @@
 //! (no `# groundtruth` line: a ROS driver's, top-first or bottom-first, with or without `ring`, NaN
 //! or zero no-returns) keeps its cells and has its rows put in elevation order first
 //! ([`classifier::ordering::organized`]); a file whose way up cannot be told is refused. An
-//! unorganized PCD is ordered as a KITTI file is. Such files hold sensor-frame points (as the drivers
+//! unorganized PCD, or a PLY, is ordered as a KITTI file is, or from its `ring` field where it has
+//! one. Such files hold sensor-frame points (as the drivers
 //! write them): `--rig` gives the mount that takes them to the vehicle frame (else they stay as
 //! they are). For a KITTI `.bin` it is every point of
 //! the file in file order; the points are first put into ring x column order ([`classifier::ordering`]):
@@ -97,7 +98,7 @@ fn list_inputs(input: &Path) -> anyhow::Result<Vec<InputFrame>> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(input)
         .with_context(|| format!("reading directory `{}`", input.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("pcd" | "bin")))
+        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("pcd" | "ply" | "bin")))
         .collect();
     files.sort();
     if files.is_empty() {
@@ -214,7 +215,9 @@ pub(crate) fn read_frame_timed(path: &Path, setup: &SensorSetup) -> anyhow::Resu
             }
             // An unorganized PCD: ordered as a KITTI file is.
             let labels = cloud.label.iter().any(|l| l.0 != 0).then_some(cloud.label.as_slice());
-            let attributes = PointAttributes { intensity: Some(&cloud.intensity), labels, time_s: Some(&cloud.time_s) };
+            let rings = info.has_ring.then_some(cloud.ring.as_slice());
+            let attributes =
+                PointAttributes { intensity: Some(&cloud.intensity), labels, time_s: Some(&cloud.time_s), rings };
             let (ordered, report) = setup.order_flat(path, &cloud.point_in_vehicle, &attributes)?;
             Ok((ReadFrame { cloud: ordered, report: Some(report) }, read_ms))
         }
@@ -223,11 +226,21 @@ pub(crate) fn read_frame_timed(path: &Path, setup: &SensorSetup) -> anyhow::Resu
             let flat = sim::io::kitti::read(path, label.is_file().then_some(label.as_path()))?;
             let read_ms = t0.elapsed().as_secs_f64() * 1e3;
             let labels = label.is_file().then_some(flat.label.as_slice());
-            let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, time_s: None };
+            let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, time_s: None, rings: None };
             let (cloud, report) = setup.order_flat(path, &flat.point_in_vehicle, &attributes)?;
             Ok((ReadFrame { cloud, report: Some(report) }, read_ms))
         }
-        _ => bail!("`{}`: unsupported file type (expected .pcd or .bin)", path.display()),
+        Some("ply") => {
+            let (cloud, has_ring) = sim::io::ply::read_with_ring(path)?;
+            let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+            let labels = cloud.label.iter().any(|l| l.0 != 0).then_some(cloud.label.as_slice());
+            let rings = has_ring.then_some(cloud.ring.as_slice());
+            let attributes =
+                PointAttributes { intensity: Some(&cloud.intensity), labels, time_s: Some(&cloud.time_s), rings };
+            let (ordered, report) = setup.order_flat(path, &cloud.point_in_vehicle, &attributes)?;
+            Ok((ReadFrame { cloud: ordered, report: Some(report) }, read_ms))
+        }
+        _ => bail!("`{}`: unsupported file type (expected .pcd, .ply or .bin)", path.display()),
     }
 }
 

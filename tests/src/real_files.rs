@@ -62,7 +62,7 @@ pub fn compare_bin(
     }
     let labels: Vec<sim::SemanticClass> = order.iter().map(|&c| cloud.label[c]).collect();
     let table = BeamTable::from_pattern(&rig.sensors[0].spec.pattern()).expect("table");
-    let attributes = PointAttributes { intensity: Some(&intensity), labels: Some(&labels), time_s: None };
+    let attributes = PointAttributes { intensity: Some(&intensity), labels: Some(&labels), time_s: None, rings: None };
     let (ordered, report) =
         order_cloud(&points, &attributes, &table, vehicle_from_sensor, choice, &UnfoldParams::default())
             .expect("order");

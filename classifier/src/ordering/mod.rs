@@ -8,6 +8,8 @@
 //! - **the beam table** ([`table`]) for clouds out of order: each point's row from its elevation,
 //!   with the table's origin offsets undone ([`beam_table`]); taken when unfolding is refused, and
 //!   the report says why;
+//! - **ring fields** ([`table::ring_wishes`]): rows from a `ring` value per point (PCD / PLY of
+//!   the ROS drivers), ring 0 at the bottom or the top as the rings' elevations say;
 //! - **organized clouds** ([`organized`]) keep their cells; their rows are put in elevation order
 //!   from the `ring` field or the rows' elevations, whichever way up the file stores them;
 //!
@@ -97,6 +99,7 @@ pub fn order_cloud(
     let rows = table.rows()?;
     let n = points_in_sensor.len();
     for (name, len) in [
+        ("rings", attributes.rings.map(<[u16]>::len)),
         ("labels", attributes.labels.map(<[SemanticClass]>::len)),
         ("intensities", attributes.intensity.map(<[f32]>::len)),
         ("times", attributes.time_s.map(<[f64]>::len)),
@@ -107,12 +110,16 @@ pub fn order_cloud(
     }
     let mut report = OrderingReport { cell_of_point: vec![None; n], ..OrderingReport::default() };
     let valid = usable(points_in_sensor, &mut report)?;
-    let wishes = match choice {
-        PathChoice::BeamTable => {
+    let wishes = match (attributes.rings, choice) {
+        (Some(rings), _) => {
+            report.path = OrderingPath::RingField;
+            table::ring_wishes(points_in_sensor, &valid, rings, &rows, &mut report).map_err(ClassifyError::Ordering)?
+        }
+        (None, PathChoice::BeamTable) => {
             report.path = OrderingPath::BeamTable;
             table::table_wishes(points_in_sensor, &valid, &rows, &mut report)
         }
-        PathChoice::Unfold | PathChoice::Auto => {
+        (None, PathChoice::Unfold | PathChoice::Auto) => {
             match unfold::unfold_wishes(points_in_sensor, &valid, &rows, params, &mut report) {
                 Ok(w) => {
                     report.path = OrderingPath::Unfolded;

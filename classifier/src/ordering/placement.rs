@@ -40,6 +40,9 @@ pub struct PointAttributes<'a> {
     pub labels: Option<&'a [SemanticClass]>,
     /// Time per input point, seconds.
     pub time_s: Option<&'a [f64]>,
+    /// A `ring` field per input point (ROS drivers' clouds): rows come from it
+    /// ([`super::OrderingPath::RingField`]).
+    pub rings: Option<&'a [u16]>,
 }
 
 /// Places `wishes` into a `rows x cols` grid (planes added as needed) and fills `report`'s

@@ -70,6 +70,19 @@ pub fn read(path: &Path) -> Result<OrderedCloud> {
 
 /// Parses PLY `bytes` (read from `path`, named in errors) into a `1 x N` cloud.
 pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
+    Ok(read_bytes_with_ring(path, bytes)?.0)
+}
+
+/// Reads a PLY point cloud and says whether its vertices carry a `ring` property (the ROS drivers'
+/// ring index; `classifier::ordering` then takes rows from it).
+pub fn read_with_ring(path: &Path) -> Result<(OrderedCloud, bool)> {
+    let bytes = read_file(path)?;
+    read_bytes_with_ring(path, &bytes)
+}
+
+/// As [`read_bytes`], also saying whether the vertices carry a `ring` property. Ring values that
+/// are negative, fractional or beyond 65535 are refused naming the file and the vertex.
+pub fn read_bytes_with_ring(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, bool)> {
     let header = plyfile::parse_header(path, bytes)?;
     let ve = header
         .elements
@@ -103,7 +116,14 @@ pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
         cloud.point_in_vehicle[row] = if hit { p } else { Vec3::NAN };
         cloud.range_m[row] = if hit { p.length() } else { f32::NAN };
         cloud.intensity[row] = get(i_int, 0.0) as f32;
-        cloud.ring[row] = get(i_ring, 0.0) as u16;
+        let ring = get(i_ring, 0.0);
+        if !(0.0..=f64::from(u16::MAX)).contains(&ring) || ring.fract() != 0.0 {
+            return Err(SimError::bad_file(
+                path,
+                format!("vertex {row}: ring {ring} is not an integer in 0 ..= 65535"),
+            ));
+        }
+        cloud.ring[row] = ring as u16;
         cloud.column[row] = row as u32;
         cloud.sensor[row] = 0;
         cloud.time_s[row] = get(i_time, 0.0);
@@ -120,5 +140,5 @@ pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
         }
         Ok(())
     })?;
-    Ok(cloud)
+    Ok((cloud, i_ring.is_some()))
 }
