@@ -19,30 +19,43 @@ use serde_json::json;
 
 use crate::plot::{LinePlot, Series, save_line_plot};
 
-/// The paper's three scenes: (scene, rig, table number, paper's rows ground / bushes / trunks /
-/// canopy as (sensed, min-z, ground, non-ground), paper's accuracy on min-z points).
-const SCENES: [(&str, &str, &str, [[u64; 4]; 4], f64); 3] = [
-    (
-        "forest-sparse",
-        "utm30lx-nodding-180",
-        "I",
-        [[53488, 677, 598, 79], [0, 0, 0, 0], [8324, 26, 4, 22], [7786, 232, 0, 232]],
-        0.9112,
-    ),
-    (
-        "forest-moderate",
-        "utm30lx-nodding",
-        "II",
-        [[74161, 1131, 928, 203], [30987, 463, 103, 360], [4483, 47, 7, 40], [32154, 664, 0, 664]],
-        0.8642,
-    ),
-    (
-        "forest-dense",
-        "utm30lx-nodding",
-        "III",
-        [[65192, 444, 440, 4], [67403, 752, 340, 412], [11494, 50, 11, 39], [10314, 379, 1, 378]],
-        0.7809,
-    ),
+/// One of the paper's scenes as this command scans it, with the paper's figures.
+struct PaperScene {
+    /// Bundled scene.
+    scene: &'static str,
+    /// Rig preset (the paper's mount and field of view).
+    rig: &'static str,
+    /// The paper's table number.
+    table: &'static str,
+    /// The paper's rows ground / bushes / trunks / canopy: sensed, min-z, ground, non-ground.
+    rows: [[u64; 4]; 4],
+    /// The paper's accuracy on min-z points.
+    accuracy: f64,
+}
+
+/// The paper's three scenes (Tables I-III).
+const SCENES: [PaperScene; 3] = [
+    PaperScene {
+        scene: "forest-sparse",
+        rig: "utm30lx-nodding-180",
+        table: "I",
+        rows: [[53488, 677, 598, 79], [0, 0, 0, 0], [8324, 26, 4, 22], [7786, 232, 0, 232]],
+        accuracy: 0.9112,
+    },
+    PaperScene {
+        scene: "forest-moderate",
+        rig: "utm30lx-nodding",
+        table: "II",
+        rows: [[74161, 1131, 928, 203], [30987, 463, 103, 360], [4483, 47, 7, 40], [32154, 664, 0, 664]],
+        accuracy: 0.8642,
+    },
+    PaperScene {
+        scene: "forest-dense",
+        rig: "utm30lx-nodding",
+        table: "III",
+        rows: [[65192, 444, 440, 4], [67403, 752, 340, 412], [11494, 50, 11, 39], [10314, 379, 1, 378]],
+        accuracy: 0.7809,
+    },
 ];
 
 /// False-positive rates at which the paper quotes a 70 % true-positive rate (sparse, moderate, dense).
@@ -81,7 +94,7 @@ struct Scanned {
 pub fn run(args: &PaperArgs) -> anyhow::Result<()> {
     let params = FeatureParams::default();
     let mut scanned = Vec::new();
-    for (scene, rig, ..) in SCENES {
+    for PaperScene { scene, rig, .. } in &SCENES {
         let mut frames = super::common::scan_standing(scene, rig, args.seed, 1, args.ideal)?;
         let cloud = frames.remove(0).cloud;
         let set = mcdaniel::candidates(&cloud, &params, None).with_context(|| format!("features of `{scene}`"))?;
@@ -94,9 +107,9 @@ pub fn run(args: &PaperArgs) -> anyhow::Result<()> {
     );
     let mut json_scenes = BTreeMap::new();
     let mut series = Vec::new();
-    for (k, (scene, rig, table, paper_rows, paper_acc)) in SCENES.iter().enumerate() {
+    for (k, PaperScene { scene, rig, table, rows: paper_rows, accuracy: paper_acc }) in SCENES.iter().enumerate() {
         let train_idx: Vec<usize> = (0..SCENES.len()).filter(|&j| j != k).collect();
-        let train_names: Vec<&str> = train_idx.iter().map(|&j| SCENES[j].0).collect();
+        let train_names: Vec<&str> = train_idx.iter().map(|&j| SCENES[j].scene).collect();
         let sets: Vec<CandidateSet> = train_idx.iter().map(|&j| scanned[j].set.clone()).collect();
         let trained_on = json!({ "scenes": train_names, "seed": args.seed, "ideal": args.ideal });
         let model = mcdaniel::train(&sets, &TrainParams { trained_on, ..Default::default() })
