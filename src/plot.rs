@@ -53,6 +53,14 @@ fn register_fonts() {
     });
 }
 
+/// Title font size: 24 px, smaller for titles that would not fit the figure's width (DejaVu
+/// Sans averages about 0.55 em per character).
+fn title_size(title: &str) -> u32 {
+    let chars = title.chars().count().max(1) as f64;
+    let fit = (f64::from(SIZE.0) - 24.0) / (0.55 * chars);
+    fit.clamp(12.0, 24.0) as u32
+}
+
 /// Line colours, distinguishable in print.
 const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
@@ -96,7 +104,7 @@ where
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("drawing the plot: {e:?}");
     root.fill(&WHITE).map_err(e)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(&plot.title, ("sans-serif", 24))
+        .caption(&plot.title, ("sans-serif", title_size(&plot.title)))
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(64)
@@ -263,7 +271,7 @@ where
 {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("drawing the heat map: {e:?}");
     root.fill(&WHITE).map_err(e)?;
-    let root = root.titled(&map.title, ("sans-serif", 24)).map_err(e)?;
+    let root = root.titled(&map.title, ("sans-serif", title_size(&map.title))).map_err(e)?;
     let (main, bar) = root.split_horizontally(SIZE.0 - 130);
     let (xe, ye) = (edges(&map.xs), edges(&map.ys));
     let mut chart = ChartBuilder::on(&main)
