@@ -303,6 +303,32 @@ mod tests {
     }
 
     #[test]
+    fn sensor_parameters_and_one_named_sensor() {
+        // LUX frequency on every sensor of the rig.
+        let s = space("[sensor]\nfrequency_hz = [12.5, 25.0]\n");
+        assert_eq!(s.count, 2 * 2 * 2);
+        let rig = s.rig(&s.decode(1)).unwrap();
+        for sensor in &rig.sensors {
+            let sim::sensor::SensorSpec::IbeoLux(lux) = &sensor.spec else { panic!("not a LUX") };
+            assert_eq!(lux.frequency_hz, 25.0);
+        }
+        // One named sensor: absolute mount values, the others untouched.
+        let s = space("body = \"roof_3\"\n[mount]\npitch_deg = [12.0]\nz_m = [1.9]\n");
+        let rig = s.rig(&s.decode(0)).unwrap();
+        let base = Rig::preset("lux-roof-4").unwrap();
+        assert_eq!(rig.sensors[3].mount.pitch_deg, 12.0);
+        assert_eq!(rig.sensors[3].mount.z_m, 1.9);
+        assert_eq!(rig.sensors[..3], base.sensors[..3]);
+        // OS1 columns.
+        let text = "scenes = [\"flat\"]\nrigs = [\"os1-64-roof\"]\nseeds = [0]\nmethods = [\"nitsch\"]\n\
+                    [sensor]\ncolumns = [512, 1024]\n";
+        let s = Space::new(Sweep::parse(text, "t").unwrap(), false).unwrap();
+        let rig = s.rig(&s.decode(0)).unwrap();
+        let sim::sensor::SensorSpec::Os1_64(os1) = &rig.sensors[0].spec else { panic!("not an OS1-64") };
+        assert_eq!(os1.columns, 512);
+    }
+
+    #[test]
     fn bad_values_and_products_are_refused() {
         let bad = |extra: &str, needle: &str| {
             let text =
