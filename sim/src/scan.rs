@@ -821,3 +821,33 @@ fn row_views(cloud: &mut OrderedCloud) -> Vec<RowView<'_>> {
     }
     views
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_prepared_scene_scans_like_a_fresh_one_and_must_match_the_mesh() {
+        let mesh = crate::scene::builtin::builtin("flat-objects").unwrap();
+        let rig = Rig::preset("lux-roof-4").unwrap();
+        let config = ScanConfig { seed: 3, ..Default::default() };
+        let fresh = Scanner::new(&mesh, &rig, config.clone()).unwrap().frame(0);
+        let prepared = PreparedScene::new(&mesh, Backend::Bvh);
+        let mut moved = rig.clone();
+        moved.sensors[0].mount.z_m += 0.3;
+        let shared = Scanner::with_prepared(&mesh, &rig, config.clone(), &prepared).unwrap().frame(0);
+        // Debug text: no-return cells hold NaN, which `==` never equals.
+        let same = |a: &OrderedCloud, b: &OrderedCloud| format!("{a:?}") == format!("{b:?}");
+        assert!(same(&fresh.cloud, &shared.cloud));
+        assert!(fresh.cloud.returns() > 1000);
+        // The same prepared scene serves another rig.
+        let other = Scanner::with_prepared(&mesh, &moved, config.clone(), &prepared).unwrap().frame(0);
+        assert!(same(&other.cloud, &Scanner::new(&mesh, &moved, config.clone()).unwrap().frame(0).cloud));
+        assert!(!same(&other.cloud, &fresh.cloud));
+        // Another mesh or backend is refused.
+        let flat = crate::scene::builtin::builtin("flat").unwrap();
+        assert!(Scanner::with_prepared(&flat, &rig, config.clone(), &prepared).is_err());
+        let parry = ScanConfig { backend: Backend::Parry, ..config };
+        assert!(Scanner::with_prepared(&mesh, &rig, parry, &prepared).is_err());
+    }
+}
