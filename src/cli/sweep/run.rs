@@ -91,9 +91,12 @@ pub fn run(space: &Space, out: &Path, shard: Shard, resume: bool, threads: usize
         let c0 = space.decode(lo);
         let (scene_name, seed) = (&space.sweep.scenes[c0.scene], space.sweep.seeds[c0.seed]);
         let t = Instant::now();
-        let scene = crate::cli::common::load_scene_full(scene_name, seed)
-            .with_context(|| format!("scene `{scene_name}` seed {seed}"))?;
-        let prepared = pool.install(|| PreparedScene::new(&scene.mesh, sim::cast::Backend::Bvh));
+        let (scene, prepared) = pool.install(|| -> anyhow::Result<_> {
+            let scene = crate::cli::common::load_scene_full(scene_name, seed)
+                .with_context(|| format!("scene `{scene_name}` seed {seed}"))?;
+            let prepared = PreparedScene::new(&scene.mesh, sim::cast::Backend::Bvh);
+            Ok((scene, prepared))
+        })?;
         prepare_s += t.elapsed().as_secs_f64();
         prepared_count += 1;
         let ran_here = pool.install(|| {
