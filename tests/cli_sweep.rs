@@ -131,14 +131,14 @@ fn sharded_and_merged_equals_unsharded_at_1_and_2_threads() {
 #[test]
 fn killed_run_resumes_without_losing_or_repeating_rows() {
     let dir = tempfile::tempdir().unwrap();
-    // 4 seeds x 6 x 5 = 120 configurations on one thread: long enough to be killed part way.
+    // 8 seeds x 6 x 5 = 240 configurations on one thread: long enough to be killed part way.
     let cfg = write(
         dir.path(),
         "kill.toml",
         r#"
 scenes = ["flat-objects"]
 rigs = ["lux-roof-4"]
-seeds = [0, 1, 2, 3]
+seeds = { from = 0, to = 7 }
 methods = ["nitsch", "ransac"]
 [mount]
 z_m = { from = 1.2, to = 2.2, step = 0.2 }
@@ -164,14 +164,14 @@ pitch_deg = [-2.0, -1.0, 0.0, 1.0, 2.0]
     child.kill().unwrap(); // SIGKILL
     child.wait().unwrap();
     let before = sorted_lines(&csv).len() - 1;
-    assert!(before < 240, "{before} rows: the sweep finished before the kill");
+    assert!(before < 480, "{before} rows: the sweep finished before the kill");
     // Without --resume the directory is refused; with it, the run completes.
     let e = err(sweep(&["--config", s(&cfg), "--out", s(&out)]));
     assert!(e.contains("--resume"), "{e}");
     let summary = ok(sweep(&["--config", s(&cfg), "--out", s(&out), "--resume", "--threads", "2"]));
     let summary: serde_json::Value = serde_json::from_str(summary.trim()).unwrap();
     let already = summary["already_done"].as_u64().unwrap();
-    assert!(already >= 5 && summary["ran"].as_u64().unwrap() == 120 - already, "{summary}");
+    assert!(already >= 5 && summary["ran"].as_u64().unwrap() == 240 - already, "{summary}");
     let resumed = sorted_lines(&csv);
     let mut unique = resumed.clone();
     unique.dedup();
