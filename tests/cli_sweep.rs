@@ -219,4 +219,9 @@ fn bad_input_is_refused_before_any_work() {
     let other = write(dir.path(), "other.toml", &SMALL.replace("[1.4, 1.6, 1.8]", "[1.5]"));
     let e = err(sweep(&["--config", s(&other), "--out", s(&out), "--resume"]));
     assert!(e.contains("another job"), "{e}");
+    // Merging directories of two different sweeps is refused.
+    let out2 = dir.path().join("out2");
+    ok(sweep(&["--config", s(&other), "--out", s(&out2)]));
+    let e = err(sweep(&["merge", s(&out), s(&out2), "--out", s(&dir.path().join("m"))]));
+    assert!(e.contains("another sweep"), "{e}");
 }
