@@ -2,6 +2,7 @@
 //! the plateaus and the hill's slope are, and the height of the bare ground at any (x, y), which the
 //! regions use.
 
+use scenes::families::basin::trapezoid;
 use scenes::families::{basin, elevated, hill, ramp};
 
 use crate::error::Result;
@@ -68,19 +69,5 @@ impl Geometry {
         let dx = (self.ground_z_m(x + h, y) - self.ground_z_m(x - h, y)) / (2.0 * h);
         let dy = (self.ground_z_m(x, y + h) - self.ground_z_m(x, y - h)) / (2.0 * h);
         glam::Vec3::new(-dx, -dy, 1.0).normalize()
-    }
-}
-
-/// 0 outside `[a, d]`, rising on `[a, b]`, 1 on `[b, c]`, falling on `[c, d]` (the basin and
-/// plateau profiles of `scenes`).
-fn trapezoid(v: f32, [a, b, c, d]: [f32; 4]) -> f32 {
-    if v <= a || v >= d {
-        0.0
-    } else if v < b {
-        (v - a) / (b - a)
-    } else if v <= c {
-        1.0
-    } else {
-        (d - v) / (d - c)
     }
 }

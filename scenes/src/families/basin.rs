@@ -64,7 +64,7 @@ impl Default for Params {
 }
 
 /// A trapezoid profile: 0 outside `[a, d]`, rising linearly on `[a, b]`, 1 on `[b, c]`, falling on `[c, d]`.
-pub(crate) fn trapezoid(v: f32, [a, b, c, d]: [f32; 4]) -> f32 {
+pub fn trapezoid(v: f32, [a, b, c, d]: [f32; 4]) -> f32 {
     if v <= a || v >= d {
         0.0
     } else if v < b {
