@@ -240,8 +240,14 @@ fn road_rows() -> (Vec<Vec3>, usize) {
 fn cluster_and_decide(pts: &[Vec3], cols: usize, params: &ClusterParams) -> (usize, Vec<bool>) {
     let rows = pts.len() / cols;
     let ranges: Vec<f32> = pts.iter().map(|p| p.length()).collect();
-    let view =
-        classifier::nitsch::neighbours::GridView { points: pts, ranges: &ranges, rows, cols, wrap: false, max_col_gap: 2 };
+    let view = classifier::nitsch::neighbours::GridView {
+        points: pts,
+        ranges: &ranges,
+        rows,
+        cols,
+        wrap: false,
+        max_col_gap: 2,
+    };
     let candidate: Vec<bool> = pts.iter().map(|p| p.is_finite()).collect();
     let normals = vec![Vec3::Z; pts.len()];
     let returns = candidate.iter().filter(|&&c| c).count();

@@ -405,7 +405,7 @@ impl Scenario {
     /// let a = Scenario::family("flat").seed(4).scan()?;
     /// let b = Scenario::family("flat").seed(4).scan()?;
     /// let bits = |s: &groundtruth_scenario::Scan| s.frames()[0].cloud.range_m.iter().map(|r| r.to_bits()).collect::<Vec<_>>();
-/// assert_eq!(bits(&a), bits(&b));
+    /// assert_eq!(bits(&a), bits(&b));
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn seed(mut self, seed: u64) -> Self {

@@ -53,7 +53,7 @@ impl Scan {
     /// let scan = groundtruth_scenario::Scenario::family("flat").scan()?;
     /// let c = &scan.frames()[0].cloud;
     /// assert_eq!(c.rows, 16);
-/// assert_eq!(c.len(), c.rows * c.cols * c.planes);
+    /// assert_eq!(c.len(), c.rows * c.cols * c.planes);
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn frames(&self) -> &[Frame] {

@@ -62,7 +62,13 @@ pub fn reversed_columns(cloud: &sim::OrderedCloud) -> Option<Vec<bool>> {
         for r in (0..rows).step_by(step) {
             if let Some(e) = elevation(r * cols + c) {
                 if let Some(prev) = last {
-                    votes += if e > prev { 1 } else if e < prev { -1 } else { 0 };
+                    votes += if e > prev {
+                        1
+                    } else if e < prev {
+                        -1
+                    } else {
+                        0
+                    };
                 }
                 last = Some(e);
             }
