@@ -214,7 +214,8 @@ fn mcdaniel_forest_model_on_ramps() {
 
 /// A 8 x 6 m platform 0.48 m high, 13 m from the ego (instance 5 of `elevated` with
 /// `dock_height_m = 0.96`): its top is flat and only a curb-like step above the yard, so the local
-/// methods call it ground: nitsch 0.99 of it, grid 0.79, mcdaniel 0.52 (ransac 0: above its plane).
+/// methods call it ground: nitsch 0.99 of it, grid 0.79, mcdaniel 0.18 with the bundled model of
+/// 3a95b28 (0.52 with the model before it; ransac 0: above its plane).
 #[test]
 fn low_platforms_look_like_ground() {
     let s = Scenario::family("elevated")
@@ -237,7 +238,7 @@ fn low_platforms_look_like_ground() {
     };
     assert!(fgr("nitsch") > 0.9);
     assert!(fgr("grid") > 0.6);
-    assert!(fgr("mcdaniel") > 0.3);
+    assert!(fgr("mcdaniel") > 0.1);
     assert!(fgr("ransac") < 0.05);
 }
 
