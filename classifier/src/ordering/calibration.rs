@@ -18,8 +18,8 @@
 //!   `vert_correction` and `rot_correction` in radians, optional `horiz_offset_correction` and
 //!   `vert_offset_correction` in metres; `num_lasers`), in either of the two styles the driver's
 //!   files use: one flow mapping per laser (`- {laser_id: 0, rot_correction: ...}`) or block
-//!   mappings (`- laser_id: 0` with the keys indented below). Only this subset of YAML is read (no
-//!   YAML library is in the dependency tree).
+//!   mappings (`- laser_id: 0` with the keys indented below); read with `serde_norway`, the
+//!   driver's other keys ignored.
 //! - `.json`: Ouster sensor metadata: `beam_altitude_angles` and `beam_azimuth_angles` (degrees; at
 //!   the top level or under `beam_intrinsics`), columns from `lidar_mode` (`"1024x10"`; at the top
 //!   level or under `config_params`). Ouster's radial `lidar_origin_to_beam_origin_mm` moves a point
@@ -171,85 +171,61 @@ fn parse_text(path: &Path, text: &str) -> Result<Calibration, CalibrationError> 
     Ok(Calibration { columns: None, lasers })
 }
 
-/// The velodyne driver's calibration YAML (subset: module docs).
+/// One laser of the velodyne driver's calibration YAML (the driver's other keys are ignored).
+#[derive(serde::Deserialize)]
+struct VelodyneLaser {
+    laser_id: usize,
+    /// Elevation, radians.
+    vert_correction: f64,
+    /// Azimuth offset, radians.
+    #[serde(default)]
+    rot_correction: f64,
+    /// Metres.
+    #[serde(default)]
+    horiz_offset_correction: f64,
+    /// Metres.
+    #[serde(default)]
+    vert_offset_correction: f64,
+}
+
+/// The velodyne driver's calibration YAML: `lasers:` (and optionally `num_lasers:`).
+#[derive(serde::Deserialize)]
+struct VelodyneCalibration {
+    lasers: Vec<VelodyneLaser>,
+    num_lasers: Option<usize>,
+}
+
+/// The velodyne driver's calibration YAML (module docs), read with `serde_norway` (a maintained
+/// YAML parser), flow and block style alike.
 fn parse_velodyne_yaml(path: &Path, text: &str) -> Result<Calibration, CalibrationError> {
-    // Each laser: its key-value pairs, from a flow mapping or a block of indented lines.
-    let mut lasers: Vec<Vec<(String, String)>> = Vec::new();
-    let mut in_lasers = false;
-    let mut num_lasers = None;
-    for (k, raw) in text.lines().enumerate() {
-        let line = raw.split('#').next().unwrap_or("");
-        let trimmed = line.trim();
-        if trimmed.is_empty() {
-            continue;
-        }
-        let indented = line.starts_with(' ') || line.starts_with('\t');
-        if !indented && !trimmed.starts_with('-') {
-            in_lasers = trimmed.starts_with("lasers:");
-            if let Some(v) = trimmed.strip_prefix("num_lasers:") {
-                num_lasers = Some(number(path, "num_lasers", v)? as usize);
-            }
-            continue;
-        }
-        if !in_lasers {
-            continue;
-        }
-        let body = if let Some(rest) = trimmed.strip_prefix('-') {
-            lasers.push(Vec::new());
-            rest.trim()
-        } else {
-            trimmed
-        };
-        let Some(current) = lasers.last_mut() else {
-            return Err(err(path, format!("line {}: a laser's keys before its `-`", k + 1)));
-        };
-        let body = body.strip_prefix('{').map(|b| b.trim_end().trim_end_matches('}')).unwrap_or(body);
-        for pair in body.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-            let (key, value) = pair
-                .split_once(':')
-                .ok_or_else(|| err(path, format!("line {}: `{pair}` is not `key: value`", k + 1)))?;
-            current.push((key.trim().to_string(), value.trim().to_string()));
-        }
-    }
-    if lasers.is_empty() {
+    let file: VelodyneCalibration =
+        serde_norway::from_str(text).map_err(|e| err(path, format!("velodyne YAML: {e}")))?;
+    if file.lasers.is_empty() {
         return Err(err(path, "no `lasers:` list"));
     }
-    let mut by_id: Vec<Option<LaserCalibration>> = vec![None; lasers.len()];
-    for (i, pairs) in lasers.iter().enumerate() {
-        let get = |key: &str| pairs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str());
-        let what = |key: &str| format!("laser {i} `{key}`");
-        let id = match get("laser_id") {
-            Some(v) => number(path, &what("laser_id"), v)? as usize,
-            None => return Err(err(path, format!("laser {i} has no `laser_id`"))),
-        };
-        if id >= lasers.len() || by_id[id].is_some() {
-            return Err(err(path, format!("laser_id {id} repeated or beyond the {} lasers", lasers.len())));
+    let n = file.lasers.len();
+    let mut by_id: Vec<Option<LaserCalibration>> = vec![None; n];
+    for (i, l) in file.lasers.iter().enumerate() {
+        if l.laser_id >= n || by_id[l.laser_id].is_some() {
+            return Err(err(path, format!("laser {i}: laser_id {} repeated or beyond the {n} lasers", l.laser_id)));
         }
-        let rad = |key: &str| -> Result<f64, CalibrationError> {
-            match get(key) {
-                Some(v) => Ok(number(path, &what(key), v)?.to_degrees()),
-                None => Ok(0.0),
-            }
-        };
-        let metres = |key: &str| -> Result<f64, CalibrationError> {
-            get(key).map(|v| number(path, &what(key), v)).transpose().map(|v| v.unwrap_or(0.0))
-        };
-        if get("vert_correction").is_none() {
-            return Err(err(path, format!("laser {i} has no `vert_correction`")));
+        let values = [l.vert_correction, l.rot_correction, l.horiz_offset_correction, l.vert_offset_correction];
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(err(path, format!("laser {i}: non-finite correction")));
         }
-        by_id[id] = Some(LaserCalibration {
-            elevation_deg: rad("vert_correction")?,
-            azimuth_offset_deg: rad("rot_correction")?,
-            horizontal_offset_m: metres("horiz_offset_correction")?,
-            vertical_offset_m: metres("vert_offset_correction")?,
+        by_id[l.laser_id] = Some(LaserCalibration {
+            elevation_deg: l.vert_correction.to_degrees(),
+            azimuth_offset_deg: l.rot_correction.to_degrees(),
+            horizontal_offset_m: l.horiz_offset_correction,
+            vertical_offset_m: l.vert_offset_correction,
         });
     }
-    if let Some(n) = num_lasers
-        && n != lasers.len()
+    if let Some(count) = file.num_lasers
+        && count != n
     {
-        return Err(err(path, format!("num_lasers {n} but {} lasers listed", lasers.len())));
+        return Err(err(path, format!("num_lasers {count} but {n} lasers listed")));
     }
-    Ok(Calibration { columns: None, lasers: by_id.into_iter().map(|l| l.expect("every id filled")).collect() })
+    Ok(Calibration { columns: None, lasers: by_id.into_iter().flatten().collect() })
 }
 
 /// Ouster sensor metadata JSON (module docs).
