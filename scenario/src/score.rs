@@ -31,10 +31,6 @@ pub struct RegionScore {
     pub tn: u64,
 }
 
-fn ratio(a: u64, b: u64) -> f64 {
-    if b == 0 { f64::NAN } else { a as f64 / b as f64 }
-}
-
 impl RegionScore {
     /// Adds one decision on a return whose truth is `ground`.
     ///
@@ -45,12 +41,14 @@ impl RegionScore {
     /// assert_eq!((s.tp, s.fp), (1, 1));
     /// ```
     pub fn add(&mut self, ground: bool, called_ground: bool) {
-        match (ground, called_ground) {
-            (true, true) => self.tp += 1,
-            (true, false) => self.fn_ += 1,
-            (false, true) => self.fp += 1,
-            (false, false) => self.tn += 1,
-        }
+        let mut c = self.counts();
+        c.add(ground, called_ground);
+        (self.tp, self.fp, self.tn, self.fn_) = (c.tp, c.fp, c.tn, c.fn_);
+    }
+
+    /// The counts as the classifier's metrics hold them (whose rates these are).
+    pub fn counts(&self) -> classifier::Confusion {
+        classifier::Confusion { tp: self.tp, fp: self.fp, tn: self.tn, fn_: self.fn_ }
     }
 
     /// Returns in the region.
@@ -60,7 +58,7 @@ impl RegionScore {
     /// assert_eq!(s.returns(), 10);
     /// ```
     pub fn returns(&self) -> u64 {
-        self.tp + self.fn_ + self.fp + self.tn
+        self.counts().total()
     }
 
     /// Ground returns in the region (`tp + fn_`).
@@ -90,7 +88,7 @@ impl RegionScore {
     /// assert_eq!(s.recall(), 0.75);
     /// ```
     pub fn recall(&self) -> f64 {
-        ratio(self.tp, self.ground())
+        self.counts().recall()
     }
 
     /// Share of the non-ground returns called ground, `fp / (fp + tn)`; NaN without non-ground.
@@ -100,7 +98,7 @@ impl RegionScore {
     /// assert_eq!(s.false_ground_rate(), 0.05);
     /// ```
     pub fn false_ground_rate(&self) -> f64 {
-        ratio(self.fp, self.non_ground())
+        self.counts().fpr()
     }
 
     /// Share of the returns called ground that are ground, `tp / (tp + fp)`; NaN if none was.
@@ -110,7 +108,7 @@ impl RegionScore {
     /// assert_eq!(s.precision(), 0.75);
     /// ```
     pub fn precision(&self) -> f64 {
-        ratio(self.tp, self.tp + self.fp)
+        self.counts().precision()
     }
 
     /// F1 of the ground class, `2 tp / (2 tp + fp + fn_)`; NaN when all three are zero.
@@ -120,7 +118,7 @@ impl RegionScore {
     /// assert_eq!(s.f1(), 0.8);
     /// ```
     pub fn f1(&self) -> f64 {
-        ratio(2 * self.tp, 2 * self.tp + self.fp + self.fn_)
+        self.counts().f1()
     }
 
     /// Share of the region's returns decided right, `(tp + tn) / returns`.
@@ -130,7 +128,7 @@ impl RegionScore {
     /// assert_eq!(s.accuracy(), 0.9);
     /// ```
     pub fn accuracy(&self) -> f64 {
-        ratio(self.tp + self.tn, self.returns())
+        self.counts().accuracy()
     }
 }
 
