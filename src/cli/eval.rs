@@ -79,6 +79,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if names.is_empty() {
         anyhow::bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));
     }
+    if let Some(model) = &args.model
+        && !names.iter().any(|n| n == "mcdaniel")
+    {
+        anyhow::bail!("--model `{}` applies to `mcdaniel`, which --methods does not name", model.display());
+    }
     // Refuse unknown names before scanning.
     for n in &names {
         super::common::method(n, args.seed, args.model.as_deref().filter(|_| n == "mcdaniel"))?;
