@@ -92,8 +92,10 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut per_file = Vec::new();
+    let mut all_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
     for (index, path) in files.iter().enumerate() {
         let (mut read, mut order, mut cls, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut file_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
         let mut last = None;
         for _ in 0..repeats {
             let t0 = Instant::now();
@@ -106,12 +108,18 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
             };
             cls.push(ms(t2));
             total.push(ms(t0));
+            for (name, s) in method.named_stage_times() {
+                match file_stages.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, v)) => v.push(s * 1e3),
+                    None => file_stages.push((name, vec![s * 1e3])),
+                }
+            }
             read.push(read_ms);
             order.push((t2 - t0).as_secs_f64() * 1e3 - read_ms);
             last = Some((frame, bytes.iter().filter(|&&b| b == 1).count(), bytes.len()));
         }
         let (frame, ground, points) = last.expect("one repeat");
-        per_file.push(serde_json::json!({
+        let mut entry = serde_json::json!({
             "file": path.display().to_string(),
             "points": points,
             "ground": ground,
@@ -123,13 +131,23 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
             "order_ms": stats(&order),
             "classify_ms": stats(&cls),
             "total_ms": stats(&total),
-        }));
+        });
+        for (name, v) in &file_stages {
+            entry[format!("{name}_ms")] = stats(v);
+        }
+        for (name, v) in file_stages {
+            match all_stages.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, all)) => all.extend(v),
+                None => all_stages.push((name, v)),
+            }
+        }
+        per_file.push(entry);
         all_read.extend(read);
         all_order.extend(order);
         all_cls.extend(cls);
         all_total.extend(total);
     }
-    let out = serde_json::json!({
+    let mut out = serde_json::json!({
         "method": args.method,
         "input": input.display().to_string(),
         "rig": rig,
@@ -142,6 +160,9 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
         "total_ms": stats(&all_total),
         "per_file": per_file,
     });
+    for (name, v) in &all_stages {
+        out[format!("{name}_ms")] = stats(v);
+    }
     println!("{}", serde_json::to_string_pretty(&out)?);
     Ok(())
 }

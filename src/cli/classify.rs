@@ -223,11 +223,11 @@ pub(crate) fn read_frame_timed(path: &Path, setup: &SensorSetup) -> anyhow::Resu
         }
         Some("bin") => {
             let label = path.with_extension("label");
-            let flat = sim::io::kitti::read(path, label.is_file().then_some(label.as_path()))?;
+            let flat = sim::io::kitti::read_points(path, label.is_file().then_some(label.as_path()))?;
             let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-            let labels = label.is_file().then_some(flat.label.as_slice());
+            let labels = flat.labels.as_deref();
             let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, time_s: None, rings: None };
-            let (cloud, report) = setup.order_flat(path, &flat.point_in_vehicle, &attributes)?;
+            let (cloud, report) = setup.order_flat(path, &flat.points, &attributes)?;
             Ok((ReadFrame { cloud, report: Some(report) }, read_ms))
         }
         Some("ply") => {

@@ -27,6 +27,7 @@ pub mod beam_table;
 pub mod calibration;
 pub mod organized;
 pub mod placement;
+mod polar;
 pub mod report;
 pub mod table;
 pub mod unfold;

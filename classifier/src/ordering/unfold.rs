@@ -26,7 +26,7 @@
 
 use glam::Vec3;
 
-use super::beam_table::{TableRows, fast_atan2, round_fast, wrap_into};
+use super::beam_table::{TableRows, wrap_into};
 use super::placement::Wish;
 use super::report::OrderingReport;
 
@@ -63,6 +63,23 @@ impl Default for UnfoldParams {
             parallax_m: 0.15,
             max_median_error_gaps: 4.0,
         }
+    }
+}
+
+/// [`wrap_into`] for `x` within one period of `[0, period)`: one add or subtract, as a select.
+#[inline(always)]
+fn wrap_once(x: f32, period: f32) -> f32 {
+    let x = if x < 0.0 { x + period } else { x };
+    if x >= period { x - period } else { x }
+}
+
+/// [`round_fast`](super::beam_table::round_fast) of every value, in place (a loop of selects that vectorizes); values are column
+/// counts, far inside the `i32` range where this equals `round_fast`.
+fn round_all(v: &mut [f32]) {
+    for x in v {
+        let y = *x + 0.5;
+        let t = y as i32 as f32;
+        *x = if t > y { t - 1.0 } else { t };
     }
 }
 
@@ -259,17 +276,13 @@ pub(crate) fn unfold_wishes(
     params: &UnfoldParams,
     report: &mut OrderingReport,
 ) -> Result<Vec<Wish>, String> {
-    let mut az = Vec::with_capacity(valid.len());
-    let mut fine = Vec::with_capacity(valid.len());
-    let mut dist = Vec::with_capacity(valid.len());
-    let offsets = rows.horizontal_m.iter().chain(&rows.vertical_m).any(|&x| x != 0.0);
-    for &k in valid {
-        let p = points[k as usize];
-        az.push(fast_atan2(p.y, p.x));
-        let d = (p.x * p.x + p.y * p.y).sqrt();
-        // Without origin offsets the elevation seen from the sensor origin is exact enough.
-        fine.push(if offsets { rows.nearest_row(p).1 } else { p.z / d.max(1e-6) });
-        dist.push(d);
+    let (az, dist, mut fine) = super::polar::polar(points, valid);
+    if rows.horizontal_m.iter().chain(&rows.vertical_m).any(|&x| x != 0.0) {
+        // With origin offsets, the elevation seen from the nearest beam's origin; without them the
+        // elevation seen from the sensor origin is exact enough.
+        for (f, &k) in fine.iter_mut().zip(valid) {
+            *f = rows.nearest_row(points[k as usize]).1;
+        }
     }
     let (starts, dir) = ring_starts(&az, &dist, &fine, rows, params)?;
     let mut bounds = starts.clone();
@@ -278,41 +291,40 @@ pub(crate) fn unfold_wishes(
     let row_of_ring = match_rows(&medians, rows, params)?;
     report.rings_found = starts.len();
     let mut wishes = Vec::with_capacity(valid.len());
+    let (mut steps, mut unwrapped) = (Vec::new(), Vec::new());
     for (ring, w) in bounds.windows(2).enumerate() {
         let row = row_of_ring[ring];
+        let (idx, h) = (&valid[w[0]..w[1]], rows.horizontal_m[row]);
+        // Fractional column steps of each point's beam azimuth.
+        steps.clear();
+        steps.extend(az[w[0]..w[1]].iter().zip(&dist[w[0]..w[1]]).map(|(&a, &d)| {
+            let beam = if h == 0.0 { a } else { a - (h / d.max(h.abs() * 1.0001)).asin() };
+            rows.column_steps(beam)
+        }));
         // Columns from azimuth, unwrapped along the ring and kept strictly moving in the scan
         // direction (a counter-clockwise turn goes down the columns): a point whose column is
         // taken by its predecessor takes the next one, the nearest free cell in scan order.
         let cols = rows.cols as f32;
         let col_dir = if rows.full_turn { -dir } else { 0.0 };
-        let (mut prev_steps, mut unwrapped, mut last) = (f32::NAN, 0.0f32, f32::NAN);
-        for (&k, &a) in valid[w[0]..w[1]].iter().zip(&az[w[0]..w[1]]) {
-            let p = points[k as usize];
-            let h = rows.horizontal_m[row];
-            let beam = if h == 0.0 {
-                a
-            } else {
-                let d = (p.x * p.x + p.y * p.y).sqrt().max(h.abs() * 1.0001);
-                a - (h / d).asin()
-            };
-            let steps = rows.column_steps(beam);
-            if col_dir == 0.0 {
-                wishes.push(Wish { point: k, row: row as u32, steps });
-                continue;
-            }
-            if prev_steps.is_nan() {
-                unwrapped = steps;
-            } else {
-                // Progress in the scan direction, in columns: a ring only moves forward, so a step
-                // back of more than `MAX_BACK_COLUMNS` (jitter, parallax) is a gap the long way round.
-                let fwd = wrap_into((steps - prev_steps) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS;
-                unwrapped += fwd * col_dir;
-            }
-            prev_steps = steps;
-            let mut c = round_fast(unwrapped);
-            if !last.is_nan() && (c - last) * col_dir < 1.0 {
-                c = last + col_dir;
-            }
+        if col_dir == 0.0 {
+            wishes.extend(idx.iter().zip(&steps).map(|(&k, &s)| Wish { point: k, row: row as u32, steps: s }));
+            continue;
+        }
+        // Progress in the scan direction, in columns: a ring only moves forward, so a step back of
+        // more than `MAX_BACK_COLUMNS` (jitter, parallax) is a gap the long way round. The sum runs
+        // in point order; the rounding and the step that keeps columns moving are separate passes
+        // written as selects (their branches were mispredicted on every other point).
+        unwrapped.clear();
+        let mut u = steps[0];
+        unwrapped.push(u);
+        for pair in steps.windows(2) {
+            u += (wrap_once((pair[1] - pair[0]) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS) * col_dir;
+            unwrapped.push(u);
+        }
+        round_all(&mut unwrapped);
+        let mut last = unwrapped[0] - col_dir;
+        for (&k, &c) in idx.iter().zip(&unwrapped) {
+            let c = if (c - last) * col_dir < 1.0 { last + col_dir } else { c };
             last = c;
             wishes.push(Wish { point: k, row: row as u32, steps: wrap_into(c, cols) });
         }

@@ -113,8 +113,45 @@ pub fn read(bin: &Path, label: Option<&Path>) -> Result<OrderedCloud> {
     read_bytes(bin, &b, label.zip(l.as_deref()))
 }
 
-/// Parses KITTI `.bin` bytes (from `bin_path`) and optional `(label_path, label_bytes)`.
-pub fn read_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<OrderedCloud> {
+/// The records of a KITTI `.bin` (and its `.label`) in file order, without the cloud around them:
+/// what ordering needs from a file of another tool ([`read_bytes`] builds a whole `1 x N` cloud).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct KittiPoints {
+    /// Point per record, sensor frame, metres (as stored: NaN or infinite coordinates kept).
+    pub points: Vec<Vec3>,
+    /// Intensity per record.
+    pub intensity: Vec<f32>,
+    /// Semantic class per record (the label's low 16 bits), when a `.label` was read.
+    pub labels: Option<Vec<SemanticClass>>,
+}
+
+/// Reads `bin` (and `label` if given) as [`KittiPoints`]; refused as [`read_bytes`] refuses.
+pub fn read_points(bin: &Path, label: Option<&Path>) -> Result<KittiPoints> {
+    let b = read_file(bin)?;
+    let l = label.map(read_file).transpose()?;
+    points_from_bytes(bin, &b, label.zip(l.as_deref()))
+}
+
+/// Parses KITTI `.bin` bytes into [`KittiPoints`] (lengths checked as in [`read_bytes`]).
+pub fn points_from_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<KittiPoints> {
+    let n = check_lengths(bin_path, bin, label)?;
+    let f = |b: &[u8], k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
+    let mut points = Vec::with_capacity(n);
+    let mut intensity = Vec::with_capacity(n);
+    for rec in bin.chunks_exact(16) {
+        points.push(Vec3::new(f(rec, 0), f(rec, 4), f(rec, 8)));
+        intensity.push(f(rec, 12));
+    }
+    let labels = label.map(|(_, lb)| {
+        lb.chunks_exact(4)
+            .map(|c| SemanticClass((u32::from_le_bytes([c[0], c[1], c[2], c[3]]) & 0xFFFF) as u16))
+            .collect()
+    });
+    Ok(KittiPoints { points, intensity, labels })
+}
+
+/// Checks that `bin` holds whole 16-byte records and `label` one uint32 per record; the record count.
+fn check_lengths(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<usize> {
     if !bin.len().is_multiple_of(16) {
         return Err(SimError::bad_file(
             bin_path,
@@ -136,6 +173,12 @@ pub fn read_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) ->
             ),
         ));
     }
+    Ok(n)
+}
+
+/// Parses KITTI `.bin` bytes (from `bin_path`) and optional `(label_path, label_bytes)`.
+pub fn read_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<OrderedCloud> {
+    let n = check_lengths(bin_path, bin, label)?;
     let mut cloud = OrderedCloud::empty(1, n, 1);
     let f = |b: &[u8], k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
     for (i, rec) in bin.chunks_exact(16).enumerate() {

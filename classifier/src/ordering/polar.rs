@@ -1,0 +1,117 @@
+//! Azimuth, horizontal distance and `tan(elevation)` of every usable point of a cloud in one pass
+//! that the compiler vectorizes: the first step of scan unfolding, where a per-point scalar loop
+//! cost about 1 ms of a 124 k-point KITTI frame. The azimuth is [`fast_atan2`]'s, bit for bit:
+//! the same operations in the same order, its branches written as selects.
+
+use glam::Vec3;
+
+#[cfg(test)]
+use super::beam_table::fast_atan2;
+
+/// Points gathered and computed together.
+const LANES: usize = 16;
+
+/// `(azimuth_rad, horizontal_distance_m, tan_elevation)` of `points[k]` for every `k` in `valid`, in
+/// that order; `tan_elevation` is seen from the sensor origin (`z / max(d, 1e-6)`).
+pub(crate) fn polar(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return polar_avx2(points, valid);
+        }
+    }
+    polar_body(points, valid)
+}
+
+/// [`polar_body`] compiled for AVX2 (plain IEEE operations only: the same bits as without it).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn polar_avx2(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+    polar_body(points, valid)
+}
+
+#[inline(always)]
+fn polar_body(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+    let m = valid.len();
+    let (mut az, mut dist, mut fine) = (vec![0.0f32; m], vec![0.0f32; m], vec![0.0f32; m]);
+    let chunks = valid.chunks(LANES).zip(az.chunks_mut(LANES)).zip(dist.chunks_mut(LANES).zip(fine.chunks_mut(LANES)));
+    for ((idx, a), (d, f)) in chunks {
+        let (mut x, mut y, mut z) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
+        for (l, &k) in idx.iter().enumerate() {
+            let p = points[k as usize];
+            (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+        }
+        let (mut oa, mut od, mut of) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
+        for l in 0..LANES {
+            oa[l] = atan2_lane(y[l], x[l]);
+            od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
+            of[l] = z[l] / od[l].max(1e-6);
+        }
+        let n = idx.len();
+        a.copy_from_slice(&oa[..n]);
+        d.copy_from_slice(&od[..n]);
+        f.copy_from_slice(&of[..n]);
+    }
+    (az, dist, fine)
+}
+
+/// [`fast_atan2`] with its branches as selects (it vectorizes); the same bits for every input.
+#[inline(always)]
+fn atan2_lane(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let swap = ay > ax;
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    let t = num / if den == 0.0 { 1.0 } else { den };
+    let t2 = t * t;
+    let mut a = t
+        * (0.999_996_1
+            + t2 * (-0.333_172_8
+                + t2 * (0.198_069_7
+                    + t2 * (-0.132_299_9 + t2 * (0.079_560_77 + t2 * (-0.033_548_71 + t2 * 0.006_793_221))))));
+    a = if swap { FRAC_PI_2 - a } else { a };
+    a = if x < 0.0 { PI - a } else { a };
+    let a = if y < 0.0 { -a } else { a };
+    let signed_pi = if y.is_sign_negative() { -PI } else { PI };
+    let on_axis = if x.is_sign_negative() { signed_pi } else { 0.0f32.copysign(y) };
+    if den == 0.0 { on_axis } else { a }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lanes_give_fast_atan2_bit_for_bit() {
+        let specials = [0.0f32, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3.5, -7.25, 1e6, f32::MIN_POSITIVE];
+        let mut pts = Vec::new();
+        for &x in &specials {
+            for &y in &specials {
+                pts.push(Vec3::new(x, y, 0.5));
+            }
+        }
+        // A dense sweep of directions and lengths (a deterministic sequence).
+        for i in 0..20_000 {
+            let t = i as f32 * 0.000_314_159_27 * 1.000_37;
+            let r = 0.3 + (i % 97) as f32 * 0.71;
+            pts.push(Vec3::new(r * t.cos(), r * t.sin(), -1.7));
+        }
+        let valid: Vec<u32> = (0..pts.len() as u32).rev().collect();
+        let (az, dist, fine) = polar(&pts, &valid);
+        for (j, &k) in valid.iter().enumerate() {
+            let p = pts[k as usize];
+            assert_eq!(az[j].to_bits(), fast_atan2(p.y, p.x).to_bits(), "azimuth of {p:?}");
+            let d = (p.x * p.x + p.y * p.y).sqrt();
+            assert_eq!(dist[j].to_bits(), d.to_bits());
+            assert_eq!(fine[j].to_bits(), (p.z / d.max(1e-6)).to_bits());
+        }
+        // Spot values against libm.
+        let (az, _, _) =
+            polar(&[Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, -2.0, 0.0), Vec3::new(1.0, 1.0, 0.0)], &[0, 1, 2]);
+        assert!((az[0] - std::f32::consts::PI).abs() < 1e-6);
+        assert!((az[1] + std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert!((az[2] - std::f32::consts::FRAC_PI_4).abs() < 1e-6);
+    }
+}
