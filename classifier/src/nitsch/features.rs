@@ -36,6 +36,7 @@
 // Lane arrays are indexed by neighbour and lane on purpose (vectorized across cells).
 #![allow(clippy::needless_range_loop)]
 
+mod general;
 mod squares;
 
 use glam::Vec3;
@@ -121,6 +122,8 @@ struct Soa {
     edge: Vec<[f32; squares::SQUARE_FIELDS]>,
     /// Horizontal edge lengths of the row being processed, by column.
     horizontal: Vec<f32>,
+    /// `valid` as bits, for the general neighbour search.
+    bits: general::ReturnBits,
 }
 
 impl Features {
@@ -262,6 +265,7 @@ struct Plane<'a> {
     y: &'a [f32],
     z: &'a [f32],
     valid: &'a [bool],
+    bits: &'a general::ReturnBits,
     tests: Tests,
     min_pairs: f32,
 }
@@ -323,6 +327,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         // `is_valid` without short-circuit branches, so that the loop vectorizes.
         (xs[i], ys[i], zs[i], valid[i]) = (p.x, p.y, p.z, p.x.is_finite() & p.y.is_finite() & p.z.is_finite());
     }
+    soa.bits.pack(&soa.valid[..n], rows, cols);
     // Ratio 0 switches the test off (keep every neighbour: factor 0).
     let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
     let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
@@ -338,6 +343,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         y: &soa.y[..n],
         z: &soa.z[..n],
         valid: &soa.valid[..n],
+        bits: &soa.bits,
         tests,
         min_pairs: params.min_valid_pairs as f32,
     };
@@ -504,7 +510,7 @@ fn fast_block(
 fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &mut Lanes) -> bool {
     let (view, tests, ranges) = (plane.view, &plane.tests, plane.view.ranges);
     let i = r * view.cols + c;
-    let nb = if plane.valid[i] { view.neighbours(r, c) } else { [None; 8] };
+    let nb = if plane.valid[i] { general::neighbours(view, plane.bits, r, c) } else { [None; 8] };
     for (k, j) in nb.into_iter().enumerate() {
         let (mut d, mut ok) = ([0.0; 3], 0.0);
         if let Some(j) = j {
