@@ -46,6 +46,22 @@ impl Scan {
         Self { frames, family, scene_name, rig, geometry, seed }
     }
 
+    /// Frames from elsewhere (files read back, a recording) as a scan of no known family, named
+    /// `scene_name`: the regions that need a family's geometry (`RampSurface`, ...) are refused,
+    /// the others work, with the bare ground at z = 0.
+    ///
+    /// ```
+    /// use groundtruth_scenario::{Region, Scan, Scenario};
+    /// let frames = Scenario::family("flat").scan()?.frames().to_vec();
+    /// let scan = Scan::from_frames(frames, "flat.pcd", sim::Rig { name: String::new(), sensors: Vec::new() });
+    /// assert!(scan.region_mask(0, &Region::Ground)?.iter().any(|&m| m));
+    /// assert!(scan.region_mask(0, &Region::RampSurface).is_err());
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn from_frames(frames: Vec<Frame>, scene_name: &str, rig: sim::Rig) -> Self {
+        Self::new(frames, "unknown".into(), scene_name.into(), rig, Geometry::Other, 0)
+    }
+
     /// The scanned frames: labelled ordered clouds (points in the vehicle frame, labels, instances,
     /// true normals, ground flags) and the vehicle poses.
     ///
@@ -226,6 +242,38 @@ impl Scan {
         }
         if score.returns() == 0 {
             return Err(ScenarioError::EmptyRegion { region: region.to_string(), frames: self.frames.len() });
+        }
+        Ok(score)
+    }
+
+    /// Scores the decisions on frame `frame` alone (one `bool` per cell) over `region`; as
+    /// [`Scan::score`] for a single frame.
+    ///
+    /// ```
+    /// use groundtruth_scenario::{Region, Scenario};
+    /// let scan = Scenario::family("flat").frames(2).scan()?;
+    /// let d = scan.classify("nitsch")?;
+    /// let s = scan.score_frame(1, &Region::Ground, &d[1])?;
+    /// assert!(s.recall() > 0.9, "{s}");
+    /// assert!(scan.score_frame(2, &Region::Ground, &d[1]).is_err());
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn score_frame(&self, frame: usize, region: &Region, decisions: &[bool]) -> Result<RegionScore> {
+        let mask = self.region_mask(frame, region)?;
+        let c = &self.frames[frame].cloud;
+        if decisions.len() != c.len() {
+            return Err(ScenarioError::Shape {
+                what: format!("cells of frame {frame}"),
+                expected: c.len(),
+                got: decisions.len(),
+            });
+        }
+        let mut score = RegionScore { region: region.to_string(), ..RegionScore::default() };
+        for i in (0..c.len()).filter(|&i| mask[i]) {
+            score.add(c.ground[i], decisions[i]);
+        }
+        if score.returns() == 0 {
+            return Err(ScenarioError::EmptyRegion { region: region.to_string(), frames: 1 });
         }
         Ok(score)
     }

@@ -1,0 +1,186 @@
+"""Type stubs of the native module ``groundtruth._native`` (re-exported by ``groundtruth``)."""
+
+from os import PathLike
+from typing import Mapping, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+SCENES: list[str]
+"""Bundled scene names (``flat``, ``ramp-up``, ``basin``, ``city``, ...)."""
+FAMILIES: list[str]
+"""Scene generator families (``flat``, ``ramp``, ``basin``, ``elevated``, ``hill``, ...)."""
+RIGS: list[str]
+"""Rig presets (``vlp16-roof``, ``hdl64e-roof``, ``os1-64-roof``, ``os1-128-roof``, ``lux``, ...)."""
+METHODS: list[str]
+"""Our classification methods (``nitsch``, ``ransac``, ``grid``, ``mcdaniel``, ...)."""
+REGIONS: list[str]
+"""Region names; also ``class:<name or id>``, ``instance:<id>``, ``range:<min>-<max>``."""
+WRITE_FORMATS: list[str]
+"""Formats ``write`` takes: ``pcd``, ``pcd-ascii``, ``ply``, ``kitti``, ``las``."""
+
+_Path = Union[str, "PathLike[str]"]
+_ParamValue = Union[float, int, bool, str]
+
+class Frame:
+    """One frame of a scan (or a file read back): the labelled ordered cloud as numpy arrays.
+
+    Arrays have the grid shape ``(planes * rows, cols)`` (row 0 = lowest beam, column 0 = left-most
+    azimuth; echo plane k occupies rows ``k * rows .. (k + 1) * rows``). Each access returns a fresh
+    copy of the Rust field.
+    """
+
+    @property
+    def rows(self) -> int:
+        """Grid rows per echo plane."""
+    @property
+    def cols(self) -> int:
+        """Grid columns."""
+    @property
+    def planes(self) -> int:
+        """Echo planes (1 except multi-echo sensors)."""
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(planes * rows, cols)``."""
+    @property
+    def index(self) -> int:
+        """Frame index within its scan."""
+    @property
+    def scene(self) -> str:
+        """Scene name (or the file read)."""
+    @property
+    def family(self) -> str:
+        """Scene generator family (``"unknown"`` for a file)."""
+    @property
+    def rig(self) -> str:
+        """Rig name (empty for a file)."""
+    @property
+    def seed(self) -> int:
+        """The scan's seed."""
+    @property
+    def returns(self) -> int:
+        """Cells holding a return."""
+    @property
+    def ground_returns(self) -> int:
+        """Returns whose ground truth is ground."""
+    @property
+    def world_from_vehicle(self) -> npt.NDArray[np.float32]:
+        """Vehicle pose at the frame's start, 4 x 4."""
+    @property
+    def xyz(self) -> npt.NDArray[np.float32]:
+        """``(H, W, 3)`` vehicle-frame positions, metres; NaN where no return."""
+    @property
+    def normal(self) -> npt.NDArray[np.float32]:
+        """``(H, W, 3)`` true unit surface normals; zero where no return."""
+    @property
+    def range(self) -> npt.NDArray[np.float32]:
+        """``(H, W)`` range from the beam origin, metres; NaN where no return."""
+    @property
+    def intensity(self) -> npt.NDArray[np.float32]:
+        """``(H, W)`` intensity in [0, 1]."""
+    @property
+    def time(self) -> npt.NDArray[np.float64]:
+        """``(H, W)`` shot time, seconds since the start of the scan."""
+    @property
+    def ring(self) -> npt.NDArray[np.uint16]:
+        """``(H, W)`` the sensor's ring index."""
+    @property
+    def column(self) -> npt.NDArray[np.uint32]:
+        """``(H, W)`` the sensor's column index."""
+    @property
+    def sensor(self) -> npt.NDArray[np.uint8]:
+        """``(H, W)`` sensor id; 255 where no sensor covers the cell."""
+    @property
+    def echo(self) -> npt.NDArray[np.uint8]:
+        """``(H, W)`` echo number (0 = first)."""
+    @property
+    def label(self) -> npt.NDArray[np.uint16]:
+        """``(H, W)`` SemanticKITTI class id (bush: 73)."""
+    @property
+    def instance(self) -> npt.NDArray[np.uint32]:
+        """``(H, W)`` instance id (0 = stuff)."""
+    @property
+    def ground(self) -> npt.NDArray[np.bool_]:
+        """``(H, W)`` ground truth."""
+    @property
+    def valid(self) -> npt.NDArray[np.bool_]:
+        """``(H, W)`` whether the cell holds a return."""
+    def points(self) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.int64]]:
+        """The returns as ``(N, 4)`` ``x y z intensity`` (vehicle frame) in grid order, and their flat
+        cell indices: ``frame.xyz.reshape(-1, 3)[cells] == points[:, :3]``."""
+    def region(self, name: str) -> npt.NDArray[np.bool_]:
+        """The ``(H, W)`` mask of region ``name``; ``ValueError`` for a region of another family."""
+    def regions(self) -> dict[str, npt.NDArray[np.bool_]]:
+        """Every region this frame's scene has, name -> mask."""
+
+class Score:
+    """Ground decisions over a region: counts (ground is positive) and rates (NaN on a zero
+    denominator)."""
+
+    @property
+    def region(self) -> str: ...
+    @property
+    def tp(self) -> int:
+        """Ground returns called ground."""
+    @property
+    def fp(self) -> int:
+        """Non-ground returns called ground."""
+    @property
+    def tn(self) -> int:
+        """Non-ground returns called non-ground."""
+    @property
+    def fn(self) -> int:
+        """Ground returns called non-ground."""
+    @property
+    def returns(self) -> int: ...
+    @property
+    def ground(self) -> int: ...
+    @property
+    def accuracy(self) -> float: ...
+    @property
+    def fpr(self) -> float:
+        """False-ground rate ``fp / (fp + tn)``."""
+    @property
+    def false_ground_rate(self) -> float: ...
+    @property
+    def precision(self) -> float: ...
+    @property
+    def recall(self) -> float: ...
+    @property
+    def f1(self) -> float: ...
+    @property
+    def iou(self) -> float: ...
+    def as_dict(self) -> dict[str, Union[str, int, float]]: ...
+
+def scan(
+    scene: str,
+    rig: str,
+    *,
+    params: Optional[Mapping[str, _ParamValue]] = None,
+    mount: Optional[Mapping[str, Union[float, int]]] = None,
+    seed: int = 0,
+    frames: int = 1,
+    speed: float = 0.0,
+    ideal: bool = False,
+) -> list[Frame]:
+    """Scan ``scene`` (bundled name, family, ``.toml`` path or TOML text) with ``rig`` (preset,
+    ``.toml`` path or TOML text). ``params``: family parameters; ``mount``: ``x_m y_m z_m roll_deg
+    pitch_deg yaw_deg`` (and ``sensor``); ``ideal``: exact ranges. Deterministic."""
+
+def regions(frame: Frame) -> dict[str, npt.NDArray[np.bool_]]:
+    """Every region of the frame's scene, name -> ``(H, W)`` mask."""
+
+def score(frame: Frame, decisions: npt.NDArray[np.bool_], region: Optional[str] = None) -> Score:
+    """Score bool ``decisions`` (grid ``(H, W)``, ``H * W`` cells, or one per return in ``points()``
+    order) over ``region`` (default: every return)."""
+
+def classify(frame: Frame, method: str = "nitsch", model: Optional[_Path] = None) -> npt.NDArray[np.bool_]:
+    """Our method ``method`` on the frame: ``(H, W)`` decisions, True = ground."""
+
+def read(path: _Path) -> Frame:
+    """Read a ``.pcd``, ``.ply`` or KITTI ``.bin`` (+ ``.label``) into a Frame."""
+
+def write(frame: Frame, path: _Path, format: Optional[str] = None) -> int:
+    """Write the frame as ``pcd``, ``pcd-ascii``, ``ply``, ``kitti`` (``.bin`` + ``.label``
+    [+ ``.calib.txt``]) or ``las``; returns the points written."""
