@@ -1,0 +1,104 @@
+"""regions(), score() and classify() against the Rust scenario API's definitions and counts."""
+
+import math
+
+import numpy as np
+import pytest
+
+import groundtruth as gt
+
+
+def test_ramp_surface_lies_on_the_ramp_plane():
+    # The Rust doc test of Region, from Python: every ramp-surface return is ground and lies on
+    # the 10 deg plane that starts 15 m ahead (the family's default distance).
+    (f,) = gt.scan("ramp", "vlp16-roof", params={"slope_deg": 10.0}, ideal=True)
+    m = f.region("ramp-surface")
+    assert m.dtype == np.bool_ and m.shape == f.shape
+    assert m.sum() > 100
+    assert f.ground[m].all()
+    p = f.xyz[m]
+    assert np.abs(p[:, 2] - (p[:, 0] - 15.0) * math.tan(math.radians(10.0))).max() < 0.05
+
+
+def test_basin_regions():
+    (f,) = gt.scan("basin", "os1-64-roof", params={"depth_m": 2.0}, ideal=True)
+    r = gt.regions(f)
+    assert {"basin-floor", "beyond-basin", "ground", "all"} <= set(r)
+    assert "ramp-surface" not in r
+    floor = f.xyz[r["basin-floor"]]
+    assert len(floor) > 50
+    assert np.abs(floor[:, 2] + 2.0).max() <= 0.05
+    assert r["beyond-basin"].sum() > 100
+    assert np.array_equal(r["all"], f.valid)
+    assert np.array_equal(r["ground"], f.ground)
+    assert np.array_equal(r["non-ground"], f.valid & ~f.ground)
+
+
+def test_elevated_regions_and_generic_regions():
+    (f,) = gt.scan("elevated", "vlp16-roof")
+    roofs = f.region("vehicle-roofs")
+    assert roofs.sum() > 50
+    assert not f.ground[roofs].any()
+    assert np.isin(f.label[roofs], [10, 18, 20]).all()
+    assert (roofs <= f.region("flat-raised-tops")).all()
+    cars = f.region("class:car")
+    assert np.array_equal(cars, f.valid & (f.label == 10))
+    assert np.array_equal(f.region("class:10"), cars)
+    band = f.region("range:5-10")
+    assert np.array_equal(band, f.valid & (f.range >= 5) & (f.range < 10))
+    inst = int(f.instance[roofs][0])
+    assert np.array_equal(f.region(f"instance:{inst}"), f.valid & (f.instance == inst))
+
+
+def test_score_counts_equal_numpy_confusion(ramp_hdl):
+    f = ramp_hdl
+    pts, cells = f.points()
+    mine = pts[:, 2] < 0.25
+    cell_d = np.zeros(f.shape, dtype=bool)
+    cell_d.reshape(-1)[cells] = mine
+    for region in (None, "ground", "ramp-surface", "flat-raised-tops", "range:0-20"):
+        m = f.region(region or "all")
+        g = f.ground
+        s = gt.score(f, mine, region=region)
+        assert (s.tp, s.fp, s.tn, s.fn) == (
+            int((m & g & cell_d).sum()),
+            int((m & ~g & cell_d).sum()),
+            int((m & ~g & ~cell_d).sum()),
+            int((m & g & ~cell_d).sum()),
+        )
+        # The same decisions as cells (grid shape, flat) score the same.
+        assert gt.score(f, cell_d, region=region).as_dict() == pytest.approx(s.as_dict(), nan_ok=True)
+        assert gt.score(f, cell_d.reshape(-1), region=region).as_dict() == pytest.approx(s.as_dict(), nan_ok=True)
+    s = gt.score(f, mine)
+    tp, fp, tn, fn = s.tp, s.fp, s.tn, s.fn
+    assert s.returns == f.returns
+    assert s.accuracy == pytest.approx((tp + tn) / (tp + fp + tn + fn))
+    assert s.fpr == pytest.approx(fp / (fp + tn))
+    assert s.precision == pytest.approx(tp / (tp + fp))
+    assert s.recall == pytest.approx(tp / (tp + fn))
+    assert s.f1 == pytest.approx(2 * tp / (2 * tp + fp + fn))
+    assert s.iou == pytest.approx(tp / (tp + fp + fn))
+
+
+def test_rates_without_denominator_are_nan(ramp_hdl):
+    s = gt.score(ramp_hdl, np.ones(ramp_hdl.shape, dtype=bool), region="ground")
+    assert s.recall == 1.0 and math.isnan(s.fpr)
+
+
+def test_classify_matches_the_rust_api_figures(ramp_hdl):
+    # Scenario::score_method("nitsch", &Region::RampSurface) of the README scenario: recall >= 0.95.
+    d = gt.classify(ramp_hdl)
+    assert d.dtype == np.bool_ and d.shape == ramp_hdl.shape
+    assert not (d & ~ramp_hdl.valid).any()
+    s = gt.score(ramp_hdl, d, region="ramp-surface")
+    assert s.recall >= 0.95, s
+    assert (s.tp, s.fn) == (5439, 50)
+    for method in gt.METHODS:
+        dm = gt.classify(ramp_hdl, method)
+        assert dm.shape == ramp_hdl.shape, method
+        assert gt.score(ramp_hdl, dm, region="ground").recall > 0.5, method
+
+
+def test_classify_is_deterministic(flat_vlp):
+    assert np.array_equal(gt.classify(flat_vlp, "ransac"), gt.classify(flat_vlp, "ransac"))
+    assert gt.score(flat_vlp, gt.classify(flat_vlp), region="ground").recall > 0.99
