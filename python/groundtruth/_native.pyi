@@ -67,6 +67,8 @@ class Frame:
     @property
     def world_from_vehicle(self) -> npt.NDArray[np.float32]:
         """Vehicle pose at the frame's start, 4 x 4."""
+    def vehicle_from_sensor(self, sensor: int = 0) -> npt.NDArray[np.float32]:
+        """The rig's sensor mount, 4 x 4 (vehicle from sensor); ``ValueError`` for a file read back."""
     @property
     def xyz(self) -> npt.NDArray[np.float32]:
         """``(H, W, 3)`` vehicle-frame positions, metres; NaN where no return."""

@@ -140,6 +140,26 @@ impl Frame {
         grid_array(py, m.to_cols_array().to_vec(), (4, 4), None)
     }
 
+    /// The mount of sensor `sensor` of the rig as a 4 x 4 float32 matrix (vehicle from sensor:
+    /// its last column is the sensor's position in the vehicle frame). `ValueError` for a sensor
+    /// the rig does not have (a file read back has none).
+    #[pyo3(signature = (sensor=0))]
+    fn vehicle_from_sensor<'py>(&self, py: Python<'py>, sensor: usize) -> PyResult<Bound<'py, PyAny>> {
+        let sensors = &self.scan.rig().sensors;
+        let s = sensors.get(sensor).ok_or_else(|| {
+            crate::error::value_error(
+                "sensor",
+                format!(
+                    "{sensor}: the rig has {} sensor(s){}",
+                    sensors.len(),
+                    if sensors.is_empty() { " (a file read back has no rig)" } else { "" }
+                ),
+            )
+        })?;
+        let m = glam::Mat4::from(s.mount.vehicle_from_sensor()).transpose();
+        grid_array(py, m.to_cols_array().to_vec(), (4, 4), None)
+    }
+
     /// Positions `x y z` in the vehicle frame (metres; x forward, y left, z up from the ground under
     /// the rear axle), float32 `(H, W, 3)`, NaN where there is no return.
     #[getter]
