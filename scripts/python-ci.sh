@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# The Python package's CI: a venv with maturin, numpy, pytest and pypatchworkpp from PyPI, the
+# `groundtruth` package installed from python/ (the README's `pip install` line, release build),
+# then pytest on python/tests (the package's tests, including round trips against the command-line
+# program's files) and examples/python (the Patchwork++ scenario suite a user would copy).
+#
+#   scripts/python-ci.sh            # venv in $GT_PY_VENV (default target/python-venv)
+#
+# Builds in the workspace's target dir (CARGO_TARGET_DIR, default ./target), so a preceding
+# `cargo build --release` has built every Rust dependency already. Needs python3 (3.9+) with venv.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+start=$(date +%s)
+log() { echo "[python-ci $(( $(date +%s) - start ))s] $*"; }
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
+venv="${GT_PY_VENV:-$CARGO_TARGET_DIR/python-venv}"
+
+if [ ! -x "$venv/bin/python" ]; then
+  log "venv $venv"
+  if ! python3 -m venv "$venv" 2>/dev/null; then
+    # Debian's python3 ships venv separately.
+    rm -rf "$venv"
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv >/dev/null
+    python3 -m venv "$venv"
+  fi
+fi
+py="$venv/bin/python"
+export PATH="$venv/bin:$PATH"  # the maturin build backend runs the `maturin` program
+log "pip install maturin numpy pytest pypatchworkpp"
+"$py" -m pip install -q --upgrade pip
+"$py" -m pip install -q "maturin>=1.9,<2" numpy pytest "pypatchworkpp==1.4.1"
+
+log "cargo build --release --bin groundtruth (the CLI of the round-trip tests)"
+cargo build --release --locked --bin groundtruth
+
+log "pip install ./python (maturin, release)"
+"$py" -m pip install -q --no-build-isolation --force-reinstall --no-deps ./python
+
+log "pytest python/tests examples/python"
+export GROUNDTRUTH_BIN="$CARGO_TARGET_DIR/release/groundtruth" GT_REQUIRE_CLI=1
+# From outside the source tree, so the installed package (not python/groundtruth/) is imported.
+(cd "$CARGO_TARGET_DIR" && "$py" -m pytest -q -p no:cacheprovider "$OLDPWD/python/tests" "$OLDPWD/examples/python")
+log "done"
