@@ -7,7 +7,8 @@
 //! for the ring. Which way the rings go is told from the data, in any frame whose z is up: in each
 //! column, two neighbouring rings' points that lie on one surface (closer than [`SAME_SURFACE`] of
 //! their horizontal distance `d`) step from the lower beam to the upper one outwards on the ground
-//! and upwards on a wall, so `dz + dd > 0`. Each such pair votes; a balance
+//! and upwards on a wall, so `dz + dd > 0`. Each such pair in every `cols / VOTING_COLUMNS`-th column
+//! votes; a balance
 //! `(up - down) / (up + down)` above [`MIN_DIRECTION_SCORE`] means ring 0 is the bottom beam, below
 //! its negative the top beam; in between the layout cannot be told and the cloud is refused with a
 //! message, never guessed. Decisions come back in the input's own cell order through
@@ -21,6 +22,9 @@ use crate::error::{ClassifyError, Result};
 /// How far the votes must lean (`(up - down) / (up + down)`) before the rows' direction counts as
 /// told.
 pub const MIN_DIRECTION_SCORE: f32 = 0.5;
+
+/// Columns that vote on which way up the rows are, at least (all of them in narrower clouds).
+pub const VOTING_COLUMNS: usize = 128;
 
 /// Neighbouring points closer than this fraction of their horizontal distance lie on one surface.
 pub const SAME_SURFACE: f32 = 0.2;
@@ -74,6 +78,9 @@ pub fn order_organized(
         row_of_ring[g] = k;
     }
     let (mut up, mut down, mut rings_with_returns) = (0usize, 0usize, 0usize);
+    // Every `stride`-th column votes (at least `VOTING_COLUMNS` of them): tens of thousands of
+    // votes decide as well as all 131,072 pairs of a 128 x 1024 frame, at an eighth of the cost.
+    let stride = (cols / VOTING_COLUMNS).max(1);
     for g in 0..rows {
         let a = row_of_ring[g] * cols;
         rings_with_returns += usize::from(cloud.point_in_vehicle[a..a + cols].iter().any(|p| p.is_finite()));
@@ -81,7 +88,7 @@ pub fn order_organized(
             break;
         }
         let b = row_of_ring[g + 1] * cols;
-        for c in 0..cols {
+        for c in (0..cols).step_by(stride) {
             let (p, q) = (cloud.point_in_vehicle[a + c], cloud.point_in_vehicle[b + c]);
             if !(p.is_finite() && q.is_finite()) {
                 continue;
