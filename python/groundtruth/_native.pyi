@@ -181,7 +181,8 @@ def classify(frame: Frame, method: str = "nitsch", model: Optional[_Path] = None
     """Our method ``method`` on the frame: ``(H, W)`` decisions, True = ground."""
 
 def read(path: _Path) -> Frame:
-    """Read a ``.pcd``, ``.ply`` or KITTI ``.bin`` (+ ``.label``) into a Frame."""
+    """Read a ``.pcd``, ``.ply``, ``.las`` or KITTI ``.bin`` (+ ``.label``) into a Frame; unorganized
+    files give a ``(1, N)`` grid in file order."""
 
 def write(frame: Frame, path: _Path, format: Optional[str] = None) -> int:
     """Write the frame as ``pcd``, ``pcd-ascii``, ``ply``, ``kitti`` (``.bin`` + ``.label``

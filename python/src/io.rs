@@ -18,8 +18,8 @@ fn extension(path: &Path) -> String {
 }
 
 /// Reads a point-cloud file into a `Frame`: an organized or unorganized PCD (ours or a ROS
-/// driver's), a PLY, or a KITTI `.bin` (with its `.label` beside it when there is one: labels and
-/// ground truth). Unorganized files give a `1 x N` grid in file order. Regions that need a scene
+/// driver's), a PLY, a LAS, or a KITTI `.bin` (with its `.label` beside it when there is one:
+/// labels and ground truth). Unorganized files give a `1 x N` grid in file order. Regions that need a scene
 /// family (`ramp-surface`, ...) are not available on a file; `ground`, `class:...` and the others
 /// are, from the file's labels. The GIL is released while reading.
 #[pyfunction]
@@ -33,6 +33,7 @@ pub fn read(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
         .detach(move || match ext.as_str() {
             "pcd" => Some(sim::io::pcd::read(&p)),
             "ply" => Some(sim::io::ply::read(&p)),
+            "las" => Some(sim::io::las::read(&p)),
             "bin" => {
                 let label = p.with_extension("label");
                 Some(sim::io::kitti::read(&p, label.is_file().then_some(label.as_path())))
@@ -43,7 +44,7 @@ pub fn read(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
             value_error(
                 "path",
                 format!(
-                    "{}: unknown extension (readable: .pcd, .ply, .bin with an optional .label; LAS is written, not read)",
+                    "{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label)",
                     path.display()
                 ),
             )

@@ -109,7 +109,7 @@ def test_bad_files(frame, tmp_path):
     txt.write_text("1 2 3\n")
     with pytest.raises(ValueError, match="path: .*unknown extension"):
         gt.read(txt)
-    for ext, content in [("pcd", b"garbage"), ("ply", b"ply\nformat nonsense\n"), ("bin", b"\x00" * 17)]:
+    for ext, content in [("pcd", b"garbage"), ("ply", b"ply\nformat nonsense\n"), ("bin", b"\x00" * 17), ("las", b"LASF" + b"\x00" * 40)]:
         p = tmp_path / f"bad.{ext}"
         p.write_bytes(content)
         with pytest.raises(ValueError, match=f"bad.{ext}"):

@@ -70,15 +70,22 @@ def test_read_the_cli_pcd_gives_the_same_grid(cli_dir, frames):
             r.region("ramp-surface")
 
 
-def test_read_the_cli_kitti_and_ply_same_counts_and_labels(cli_dir, frames):
+def test_read_the_cli_kitti_ply_las_same_counts_and_labels(cli_dir, frames):
     for f in frames:
         stem = f"frame_{f.index:06d}"
         labels = np.bincount(f.label[f.valid], minlength=256)
-        for ext in ("bin", "ply"):
+        for ext in ("bin", "ply", "las"):
             r = gt.read(cli_dir / "scan" / f"{stem}.{ext}")
             assert r.shape == (1, f.returns), ext
             assert r.returns == f.returns and r.ground_returns == f.ground_returns, ext
             assert np.array_equal(np.bincount(r.label[r.valid], minlength=256), labels), ext
+        # PLY and LAS hold the returns in grid order: the same points, labels, instances, rings.
+        for ext in ("ply", "las"):
+            r = gt.read(cli_dir / "scan" / f"{stem}.{ext}")
+            pts, cells = f.points()
+            assert np.allclose(r.xyz[0], pts[:, :3], atol=1e-4), ext
+            for name in ("label", "instance", "ground", "ring"):
+                assert np.array_equal(getattr(r, name)[0], getattr(f, name).reshape(-1)[cells]), (ext, name)
         # The .label file itself: class | instance << 16 per point of the .bin.
         raw = np.fromfile(cli_dir / "scan" / f"{stem}.label", dtype="<u4")
         assert len(raw) == f.returns

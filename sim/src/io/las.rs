@@ -1,5 +1,6 @@
 //! LAS 1.4 writer (point data format 6, via the `las` crate) for a frame's returns; LAZ
-//! (compressed, same content) when the crate is built with the `laz` feature.
+//! (compressed, same content) when the crate is built with the `laz` feature. [`read`] reads
+//! such a file back (and other tools' LAS files, with what they carry).
 //!
 //! Per point, in grid order (returns only):
 //! - `x y z`: vehicle frame, metres, stored with scale 0.0001 m and offset 0;
@@ -132,4 +133,76 @@ pub fn write_with(path: &Path, cloud: &OrderedCloud, compressed: bool) -> Result
     let (bytes, n) = encode_with(path, cloud, compressed)?;
     super::atomic::write_bytes_atomic(path, &bytes)?;
     Ok(n)
+}
+
+/// Reads a LAS file (ours or another tool's) into a `1 x N` cloud in file order, the inverse of
+/// [`encode`] for our files: `x y z` (vehicle frame for ours; within the 0.1 mm scale), intensity
+/// / 65535, `echo` = return number - 1, `time_s` = GPS time (0 without), `label` = `user_data`
+/// (our class id; 0 where another tool left it 0), ground = classification 2, `ring` = point
+/// source id, `sensor` = scanner channel, `instance` = the first 4 extra bytes when the record has
+/// exactly 4 (our `instance` field), `range_m` = distance from the origin, `column` = point index.
+/// A malformed file is an error naming it.
+pub fn read(path: &Path) -> Result<OrderedCloud> {
+    let mut reader = las::Reader::from_path(path).map_err(|e| las_err(path, e))?;
+    let data = reader.read_all().map_err(|e| las_err(path, e))?;
+    let n = data.len();
+    let mut c = OrderedCloud::empty(1, n, 1);
+    for (i, p) in data.points().enumerate() {
+        let p = p.map_err(|e| las_err(path, e))?;
+        let v = glam::Vec3::new(p.x as f32, p.y as f32, p.z as f32);
+        if !v.is_finite() {
+            return Err(SimError::bad_file(path, format!("LAS: point {i} has a non-finite coordinate")));
+        }
+        c.point_in_vehicle[i] = v;
+        c.range_m[i] = v.length();
+        c.intensity[i] = f32::from(p.intensity) / 65535.0;
+        c.echo[i] = p.return_number.saturating_sub(1);
+        c.time_s[i] = p.gps_time.unwrap_or(0.0);
+        c.label[i] = SemanticClass(u16::from(p.user_data));
+        c.ground[i] = u8::from(p.classification) == 2;
+        c.ring[i] = p.point_source_id;
+        c.sensor[i] = p.scanner_channel;
+        c.column[i] = u32::try_from(i).unwrap_or(u32::MAX);
+        if let [a, b, c4, d] = p.extra_bytes[..] {
+            c.instance[i] = u32::from_le_bytes([a, b, c4, d]);
+        }
+    }
+    Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn read_gives_back_what_encode_wrote() {
+        let mut c = OrderedCloud::empty(2, 3, 1);
+        for (i, k) in [(1usize, 0u16), (4, 1)] {
+            c.point_in_vehicle[i] = glam::Vec3::new(1.5 + f32::from(k), -2.25, 0.125);
+            c.range_m[i] = c.point_in_vehicle[i].length();
+            c.intensity[i] = 0.5;
+            c.ring[i] = k + 7;
+            c.time_s[i] = 0.01 * f64::from(k);
+            c.label[i] = if k == 0 { SemanticClass::ROAD } else { SemanticClass::CAR };
+            c.ground[i] = k == 0;
+            c.instance[i] = 70_000 * u32::from(k);
+            c.sensor[i] = 0;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.las");
+        assert_eq!(write(&path, &c).unwrap(), 2);
+        let r = read(&path).unwrap();
+        assert_eq!((r.rows, r.cols, r.returns()), (1, 2, 2));
+        for (j, i) in [(0usize, 1usize), (1, 4)] {
+            assert!((r.point_in_vehicle[j] - c.point_in_vehicle[i]).abs().max_element() < 1e-4);
+            assert_eq!(
+                (r.label[j], r.ground[j], r.ring[j], r.instance[j]),
+                (c.label[i], c.ground[i], c.ring[i], c.instance[i])
+            );
+            assert_eq!(r.time_s[j], c.time_s[i]);
+            assert!((r.intensity[j] - 0.5).abs() < 1e-4);
+        }
+        std::fs::write(&path, b"LASF truncated").unwrap();
+        assert!(read(&path).unwrap_err().to_string().contains("x.las"));
+    }
 }
