@@ -65,6 +65,7 @@ use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
 use crate::nitsch::neighbours::GridView;
+use crate::nitsch::return_bits::{self, ReturnBits};
 
 /// Parameters of clustering and of the cluster rules.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -174,6 +175,8 @@ pub struct ClusterWorkspace {
     valid: Vec<bool>,
     /// Per column of the row being clustered: returns in the rows below, at and above.
     column_valid: Vec<bool>,
+    /// `valid` as bits, for the neighbour search of cells that lack a direct neighbour.
+    bits: ReturnBits,
     /// Cluster roots in increasing order (the per-root arrays are only read and reset there).
     roots: Vec<u32>,
     /// Returns of the plane of the last clustering.
@@ -351,6 +354,7 @@ fn cluster_body(
         }
     }
     ws.returns = ws.valid.iter().map(|&v| usize::from(v)).sum();
+    ws.bits.pack(&ws.valid[..n], rows, cols);
     // Only cells with a return can be candidates: the members, each its own root to begin with.
     ws.parent.clear();
     ws.parent.resize(n, NONE);
@@ -430,7 +434,7 @@ fn cluster_body(
                     }
                 }
             } else {
-                for j in view.neighbours(r, c).into_iter().flatten() {
+                for j in return_bits::neighbours(view, &ws.bits, r, c).into_iter().flatten() {
                     if parent[j] != NONE {
                         // The unions above may have moved this cell's root.
                         ri = find(parent, ri);

@@ -36,13 +36,13 @@
 // Lane arrays are indexed by neighbour and lane on purpose (vectorized across cells).
 #![allow(clippy::needless_range_loop)]
 
-mod general;
 mod squares;
 
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
 use crate::nitsch::neighbours::GridView;
+use crate::nitsch::return_bits::{self, ReturnBits};
 
 /// Parameters of the feature computation besides the neighbourhood.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,7 +123,7 @@ struct Soa {
     /// Horizontal edge lengths of the row being processed, by column.
     horizontal: Vec<f32>,
     /// `valid` as bits, for the general neighbour search.
-    bits: general::ReturnBits,
+    bits: ReturnBits,
 }
 
 impl Features {
@@ -265,7 +265,7 @@ struct Plane<'a> {
     y: &'a [f32],
     z: &'a [f32],
     valid: &'a [bool],
-    bits: &'a general::ReturnBits,
+    bits: &'a ReturnBits,
     tests: Tests,
     min_pairs: f32,
 }
@@ -510,7 +510,7 @@ fn fast_block(
 fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &mut Lanes) -> bool {
     let (view, tests, ranges) = (plane.view, &plane.tests, plane.view.ranges);
     let i = r * view.cols + c;
-    let nb = if plane.valid[i] { general::neighbours(view, plane.bits, r, c) } else { [None; 8] };
+    let nb = if plane.valid[i] { return_bits::neighbours(view, plane.bits, r, c) } else { [None; 8] };
     for (k, j) in nb.into_iter().enumerate() {
         let (mut d, mut ok) = ([0.0; 3], 0.0);
         if let Some(j) = j {

@@ -10,6 +10,7 @@
 pub mod cluster;
 pub mod features;
 pub mod neighbours;
+mod return_bits;
 pub mod row_order;
 
 use glam::Vec3;

@@ -1,5 +1,5 @@
-//! The general neighbour search of cells that lack a direct neighbour, on a bitmask of the plane's
-//! returns: [`GridView::neighbours`] looks each candidate up in the points (a branch and three
+//! The general neighbour search of cells that lack a direct neighbour (features and clustering),
+//! on a bitmask of the plane's returns: [`GridView::neighbours`] looks each candidate up in the points (a branch and three
 //! float tests per cell, through calls that do not inline); here a row's returns around the column
 //! are one machine word, so finding the nearest return is a few bit operations. The result is the
 //! same as [`GridView::neighbours`] for every cell (tested on random masks); cells near the left
@@ -18,14 +18,14 @@ const REACH: usize = 2 * MAX_FAST_GAP;
 /// One bit per cell of a plane, row by row (`words` 64-bit words a row), set where the cell holds a
 /// return. Buffers are reused between frames.
 #[derive(Clone, Debug, Default)]
-pub(super) struct ReturnBits {
+pub(crate) struct ReturnBits {
     bits: Vec<u64>,
     words: usize,
 }
 
 impl ReturnBits {
     /// Packs `valid` (row-major, `rows * cols`).
-    pub(super) fn pack(&mut self, valid: &[bool], rows: usize, cols: usize) {
+    pub(crate) fn pack(&mut self, valid: &[bool], rows: usize, cols: usize) {
         // One spare word a row, so a window never reads past the row's last word.
         self.words = cols.div_ceil(64) + 1;
         self.bits.clear();
@@ -82,7 +82,7 @@ fn nearest(w: u64, gap: usize) -> Option<usize> {
 
 /// [`GridView::neighbours`] of `(r, c)` through `bits` (the view's returns).
 #[inline]
-pub(super) fn neighbours(view: &GridView<'_>, bits: &ReturnBits, r: usize, c: usize) -> [Option<usize>; 8] {
+pub(crate) fn neighbours(view: &GridView<'_>, bits: &ReturnBits, r: usize, c: usize) -> [Option<usize>; 8] {
     let (rows, cols, gap) = (view.rows, view.cols, view.max_col_gap);
     if gap > MAX_FAST_GAP || c < REACH || c + REACH >= cols {
         return view.neighbours(r, c);
