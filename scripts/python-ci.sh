@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The Python package's CI: a venv with maturin, numpy, pytest and pypatchworkpp from PyPI, the
+# The Python package's CI: a venv with maturin, numpy, pytest, pypatchworkpp and mypy from PyPI, the
 # `groundtruth` package installed from python/ (the README's `pip install` line, release build),
-# then pytest on python/tests (the package's tests, including round trips against the command-line
-# program's files) and examples/python (the Patchwork++ scenario suite a user would copy).
+# then mypy's stubtest (the .pyi stubs against the built module) and pytest on python/tests (the
+# package's tests, including round trips against the command-line program's files) and
+# examples/python (the Patchwork++ scenario suite a user would copy).
 #
 #   scripts/python-ci.sh            # venv in $GT_PY_VENV (default target/python-venv)
 #
@@ -28,13 +29,16 @@ py="$venv/bin/python"
 export PATH="$venv/bin:$PATH"  # the maturin build backend runs the `maturin` program
 log "pip install maturin numpy pytest pypatchworkpp"
 "$py" -m pip install -q --upgrade pip
-"$py" -m pip install -q "maturin>=1.9,<2" numpy pytest "pypatchworkpp==1.4.1"
+"$py" -m pip install -q "maturin>=1.9,<2" numpy pytest "pypatchworkpp==1.4.1" mypy
 
 log "cargo build --release --bin groundtruth (the CLI of the round-trip tests)"
 cargo build --release --locked --bin groundtruth
 
 log "pip install ./python (maturin, release)"
 "$py" -m pip install -q --no-build-isolation --force-reinstall --no-deps ./python
+
+log "mypy.stubtest: the type stubs match the module"
+(cd "$CARGO_TARGET_DIR" && "$py" -m mypy.stubtest groundtruth._native)
 
 log "pytest python/tests examples/python"
 export GROUNDTRUTH_BIN="$CARGO_TARGET_DIR/release/groundtruth" GT_REQUIRE_CLI=1

@@ -1,11 +1,29 @@
 """Type stubs of the native module ``groundtruth._native`` (re-exported by ``groundtruth``)."""
 
 from os import PathLike
-from typing import Mapping, Optional, Union
+from typing import Mapping, Optional, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
+__all__ = [
+    "__version__",
+    "SCENES",
+    "FAMILIES",
+    "RIGS",
+    "METHODS",
+    "REGIONS",
+    "WRITE_FORMATS",
+    "Frame",
+    "Score",
+    "scan",
+    "score",
+    "regions",
+    "classify",
+    "read",
+    "write",
+    "_time_rust_scan",
+]
 __version__: str
 SCENES: list[str]
 """Bundled scene names (``flat``, ``ramp-up``, ``basin``, ``city``, ...)."""
@@ -23,6 +41,7 @@ WRITE_FORMATS: list[str]
 _Path = Union[str, "PathLike[str]"]
 _ParamValue = Union[float, int, bool, str]
 
+@final
 class Frame:
     """One frame of a scan (or a file read back): the labelled ordered cloud as numpy arrays.
 
@@ -116,6 +135,7 @@ class Frame:
     def regions(self) -> dict[str, npt.NDArray[np.bool_]]:
         """Every region this frame's scene has, name -> mask."""
 
+@final
 class Score:
     """Ground decisions over a region: counts (ground is positive) and rates (NaN on a zero
     denominator)."""
@@ -187,3 +207,6 @@ def read(path: _Path) -> Frame:
 def write(frame: Frame, path: _Path, format: Optional[str] = None) -> int:
     """Write the frame as ``pcd``, ``pcd-ascii``, ``ply``, ``kitti`` (``.bin`` + ``.label``
     [+ ``.calib.txt``]) or ``las``; returns the points written."""
+
+def _time_rust_scan(scene: str, rig: str, repeats: int = 5, ideal: bool = False) -> list[float]:
+    """Benchmark helper: seconds of ``repeats`` scans through the Rust API alone."""

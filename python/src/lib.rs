@@ -64,7 +64,10 @@ fn scenario(
 /// ranges, measurement effects off. Deterministic: the same arguments give the same arrays. The
 /// GIL is released while the scene is generated and scanned.
 #[pyfunction]
-#[pyo3(signature = (scene, rig, *, params=None, mount=None, seed=None, frames=None, speed=None, ideal=false))]
+#[pyo3(
+    signature = (scene, rig, *, params=None, mount=None, seed=None, frames=None, speed=None, ideal=false),
+    text_signature = "(scene, rig, *, params=None, mount=None, seed=0, frames=1, speed=0.0, ideal=False)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn scan(
     py: Python<'_>,

@@ -119,3 +119,27 @@ def test_lists_of_names():
     assert "nitsch" in gt.METHODS and "mcdaniel" in gt.METHODS
     assert "ramp-surface" in gt.REGIONS
     assert math.isfinite(float(gt.__version__.split(".")[0]))
+
+
+def test_the_gil_is_released_while_scanning():
+    # A Python thread keeps counting while another scans: with the GIL held through the Rust call
+    # it would not run at all during the scan.
+    import threading
+
+    count = [0]
+    stop = threading.Event()
+
+    def spin():
+        while not stop.is_set():
+            count[0] += 1
+
+    t = threading.Thread(target=spin)
+    t.start()
+    try:
+        before = count[0]
+        gt.scan("city", "os1-64-roof")
+        during = count[0] - before
+    finally:
+        stop.set()
+        t.join()
+    assert during > 20_000, during
