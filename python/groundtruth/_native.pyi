@@ -1,7 +1,7 @@
 """Type stubs of the native module ``groundtruth._native`` (re-exported by ``groundtruth``)."""
 
 from os import PathLike
-from typing import Mapping, Optional, Union, final
+from typing import Mapping, Optional, Sequence, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -193,9 +193,15 @@ def scan(
 def regions(frame: Frame) -> dict[str, npt.NDArray[np.bool_]]:
     """Every region of the frame's scene, name -> ``(H, W)`` mask."""
 
+@overload
 def score(frame: Frame, decisions: npt.NDArray[np.bool_], region: Optional[str] = None) -> Score:
     """Score bool ``decisions`` (grid ``(H, W)``, ``H * W`` cells, or one per return in ``points()``
     order) over ``region`` (default: every return)."""
+@overload
+def score(
+    frame: Sequence[Frame], decisions: Sequence[npt.NDArray[np.bool_]], region: Optional[str] = None
+) -> Score:
+    """Pooled over all the frames of one scan (in order), one decision array per frame."""
 
 def classify(frame: Frame, method: str = "nitsch", model: Optional[_Path] = None) -> npt.NDArray[np.bool_]:
     """Our method ``method`` on the frame: ``(H, W)`` decisions, True = ground."""

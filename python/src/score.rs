@@ -4,7 +4,7 @@
 use groundtruth_scenario::{Region, RegionScore, ScenarioError};
 use numpy::{PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList, PyTuple};
 
 use crate::args::type_name;
 use crate::error::{scenario_error, type_error, value_error};
@@ -223,14 +223,62 @@ pub fn cell_decisions(frame: &Frame, decisions: &Bound<'_, PyAny>) -> PyResult<V
 
 /// Scores ground decisions on `frame` over `region` (default: every return): accuracy, FPR,
 /// precision, recall, F1, IoU and the counts. `decisions` is a numpy bool array over the cells
-/// (grid shape or flat) or over the returns in `points()` order.
+/// (grid shape or flat) or over the returns in `points()` order. With a list of frames (all the
+/// frames of one scan, in order, as `scan()` returns them) and a list of decision arrays, the
+/// counts are pooled over the frames, as the Rust API's `Scan::score` pools them.
 #[pyfunction]
 #[pyo3(signature = (frame, decisions, region=None))]
-pub fn score(frame: &Frame, decisions: &Bound<'_, PyAny>, region: Option<&str>) -> PyResult<Score> {
+pub fn score(frame: &Bound<'_, PyAny>, decisions: &Bound<'_, PyAny>, region: Option<&str>) -> PyResult<Score> {
     let region = parse_region(region.unwrap_or("all"))?;
-    let d = cell_decisions(frame, decisions)?;
-    let s = frame.scan.score_frame(frame.k, &region, &d).map_err(scenario_error)?;
-    Ok(Score(s))
+    if let Ok(f) = frame.cast::<Frame>() {
+        let f = f.get();
+        let d = cell_decisions(f, decisions)?;
+        return Ok(Score(f.scan.score_frame(f.k, &region, &d).map_err(scenario_error)?));
+    }
+    let expected = "a Frame, or a list of the Frames of one scan";
+    if !(frame.is_instance_of::<PyList>() || frame.is_instance_of::<PyTuple>()) {
+        return Err(type_error("frame", format!("expected {expected}, got {}", type_name(frame))));
+    }
+    let frames: Vec<Bound<'_, Frame>> = frame
+        .try_iter()?
+        .map(|f| {
+            let f = f?;
+            f.cast_into::<Frame>().map_err(|e| {
+                type_error(
+                    "frame",
+                    format!("expected {expected}, got a list holding {}", type_name(e.into_inner().as_any())),
+                )
+            })
+        })
+        .collect::<PyResult<_>>()?;
+    let Some(first) = frames.first() else {
+        return Err(value_error("frame", "an empty list"));
+    };
+    let scan = first.get().scan.clone();
+    let whole = frames.len() == scan.frames().len()
+        && frames.iter().enumerate().all(|(i, f)| std::sync::Arc::ptr_eq(&f.get().scan, &scan) && f.get().k == i);
+    if !whole {
+        return Err(value_error(
+            "frame",
+            format!(
+                "pooled scores take all {} frames of one scan, in order, as scan() returns them",
+                scan.frames().len()
+            ),
+        ));
+    }
+    if !(decisions.is_instance_of::<PyList>() || decisions.is_instance_of::<PyTuple>()) {
+        return Err(type_error(
+            "decisions",
+            format!("expected a list of one bool array per frame, got {}", type_name(decisions)),
+        ));
+    }
+    let arrays: Vec<Bound<'_, PyAny>> = decisions.try_iter()?.collect::<PyResult<_>>()?;
+    if arrays.len() != frames.len() {
+        return Err(value_error("decisions", format!("{} arrays for {} frames", arrays.len(), frames.len())));
+    }
+    let cells: Vec<Vec<bool>> =
+        frames.iter().zip(&arrays).map(|(f, d)| cell_decisions(f.get(), d)).collect::<PyResult<_>>()?;
+    Ok(Score(scan.score(&region, &cells).map_err(scenario_error)?))
 }
 
 /// Every region the frame's scene has, name -> bool `(H, W)` mask.

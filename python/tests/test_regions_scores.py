@@ -102,3 +102,28 @@ def test_classify_matches_the_rust_api_figures(ramp_hdl):
 def test_classify_is_deterministic(flat_vlp):
     assert np.array_equal(gt.classify(flat_vlp, "ransac"), gt.classify(flat_vlp, "ransac"))
     assert gt.score(flat_vlp, gt.classify(flat_vlp), region="ground").recall > 0.99
+
+
+def test_pooled_score_over_the_frames_of_a_scan():
+    frames = gt.scan("basin", "vlp16-roof", frames=3, speed=8.0)
+    decisions = [gt.classify(f) for f in frames]
+    pooled = gt.score(frames, decisions, region="beyond-basin")
+    per_frame = [gt.score(f, d, region="beyond-basin") for f, d in zip(frames, decisions)]
+    for k in ("tp", "fp", "tn", "fn"):
+        assert getattr(pooled, k) == sum(getattr(s, k) for s in per_frame), k
+    assert pooled.returns > 1000, pooled
+    # Per-return decisions work per frame too.
+    points = [f.points()[0][:, 2] < 0.3 for f in frames]
+    assert gt.score(tuple(frames), points).returns == sum(f.returns for f in frames)
+    with pytest.raises(ValueError, match="frame: pooled scores take all 3 frames"):
+        gt.score(frames[:2], decisions[:2])
+    with pytest.raises(ValueError, match="frame: pooled scores take all 3 frames"):
+        gt.score(frames[::-1], decisions)
+    with pytest.raises(ValueError, match="decisions: 2 arrays for 3 frames"):
+        gt.score(frames, decisions[:2])
+    with pytest.raises(TypeError, match="decisions: expected a list"):
+        gt.score(frames, decisions[0])
+    with pytest.raises(TypeError, match="frame: expected a Frame, or a list"):
+        gt.score([frames[0], "x"], decisions)
+    with pytest.raises(ValueError, match="frame: an empty list"):
+        gt.score([], [])
