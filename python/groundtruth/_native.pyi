@@ -203,8 +203,14 @@ def score(
 ) -> Score:
     """Pooled over all the frames of one scan (in order), one decision array per frame."""
 
+@overload
 def classify(frame: Frame, method: str = "nitsch", model: Optional[_Path] = None) -> npt.NDArray[np.bool_]:
     """Our method ``method`` on the frame: ``(H, W)`` decisions, True = ground."""
+@overload
+def classify(
+    frame: Sequence[Frame], method: str = "nitsch", model: Optional[_Path] = None
+) -> list[npt.NDArray[np.bool_]]:
+    """One method instance over the frames in order (``grid`` accumulates its map)."""
 
 def read(path: _Path) -> Frame:
     """Read a ``.pcd``, ``.ply``, ``.las`` or KITTI ``.bin`` (+ ``.label``) into a Frame; unorganized

@@ -2,11 +2,15 @@
 //! the GIL released.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use classifier::{FrameInput, GroundClassifier};
+use groundtruth_scenario::Scan;
 use pyo3::prelude::*;
+use pyo3::types::{PyList, PyTuple};
 
-use crate::error::{classify_error, value_error};
+use crate::args::type_name;
+use crate::error::{classify_error, type_error, value_error};
 use crate::frame::{Frame, grid_array};
 
 /// The method `name` with its default parameters, as the command line builds it: `model` is a
@@ -34,24 +38,57 @@ fn method(name: &str, model: Option<&PathBuf>) -> PyResult<Box<dyn GroundClassif
 
 /// Classifies `frame` with our method `method` (`groundtruth.METHODS`: `nitsch`, `ransac`, `grid`,
 /// `mcdaniel`, ...); returns the decisions as a bool `(H, W)` array, True = ground (False where no
-/// return). `model`: a trained `mcdaniel` model file. The GIL is released while it runs.
+/// return). Given a list of frames, one method instance classifies them in order and a list of
+/// arrays comes back (`grid` accumulates its map over the frames, as `groundtruth classify` does on
+/// a directory). `model`: a trained `mcdaniel` model file. The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (frame, method="nitsch", model=None))]
 pub fn classify<'py>(
     py: Python<'py>,
-    frame: &Frame,
+    frame: &Bound<'py, PyAny>,
     method: &str,
     model: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut m = self::method(method, model.as_ref())?;
-    let scan = frame.scan.clone();
-    let k = frame.k;
+    let single = frame.cast::<Frame>().is_ok();
+    let frames: Vec<Bound<'py, Frame>> = if single {
+        vec![frame.cast::<Frame>()?.clone()]
+    } else if frame.is_instance_of::<PyList>() || frame.is_instance_of::<PyTuple>() {
+        frame
+            .try_iter()?
+            .map(|f| {
+                let f = f?;
+                f.cast_into::<Frame>().map_err(|e| {
+                    type_error(
+                        "frame",
+                        format!("expected a list of Frames, got one holding {}", type_name(e.into_inner().as_any())),
+                    )
+                })
+            })
+            .collect::<PyResult<_>>()?
+    } else {
+        return Err(type_error("frame", format!("expected a Frame or a list of Frames, got {}", type_name(frame))));
+    };
+    let work: Vec<(Arc<Scan>, usize)> = frames.iter().map(|f| (f.get().scan.clone(), f.get().k)).collect();
     let decisions = py
         .detach(move || {
-            let f = &scan.frames()[k];
-            let input = FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };
-            m.classify(&input)
+            work.iter()
+                .map(|(scan, k)| {
+                    let f = &scan.frames()[*k];
+                    let input =
+                        FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };
+                    m.classify(&input)
+                })
+                .collect::<Result<Vec<_>, _>>()
         })
         .map_err(classify_error)?;
-    grid_array(py, decisions, frame.grid(), None)
+    let arrays: Vec<Bound<'py, PyAny>> =
+        frames.iter().zip(decisions).map(|(f, d)| grid_array(py, d, f.get().grid(), None)).collect::<PyResult<_>>()?;
+    if single {
+        if let Some(a) = arrays.into_iter().next() {
+            return Ok(a);
+        }
+        return Err(value_error("frame", "no decisions came back"));
+    }
+    Ok(PyList::new(py, arrays)?.into_any())
 }

@@ -100,6 +100,10 @@ def test_bad_classify(frame, tmp_path):
         gt.classify(frame, "mcdaniel", model=bad)
     with pytest.raises(TypeError, match="method"):
         gt.classify(frame, 3)
+    with pytest.raises(TypeError, match="frame: expected a Frame or a list of Frames, got str"):
+        gt.classify("frame.pcd")
+    with pytest.raises(TypeError, match="frame: expected a list of Frames, got one holding int"):
+        gt.classify([frame, 1])
 
 
 def test_bad_files(frame, tmp_path):

@@ -21,6 +21,7 @@ def cli_dir(cli, tmp_path_factory):
         "--format", "pcd,ply,kitti,las", "--out", str(d / "scan"),
     )  # fmt: skip
     cli("classify", "--method", "nitsch", "--input", str(d / "scan"), "--out", str(d / "ground"))
+    cli("classify", "--method", "grid", "--input", str(d / "scan"), "--out", str(d / "grid"))
     return d
 
 
@@ -100,3 +101,12 @@ def test_classify_gives_the_cli_ground_files(cli_dir, frames):
         # And on the file read back.
         back = gt.classify(gt.read(cli_dir / "scan" / f"frame_{f.index:06d}.pcd"))
         assert np.array_equal(back, mine)
+
+
+def test_classify_over_frames_gives_the_cli_grid_files(cli_dir, frames):
+    # `grid` accumulates its world map over the frames: one method instance over the list, in order.
+    decisions = gt.classify(frames, "grid")
+    assert isinstance(decisions, list) and len(decisions) == 2
+    for f, d in zip(frames, decisions):
+        cli_ground = np.fromfile(cli_dir / "grid" / f"frame_{f.index:06d}.ground", dtype=np.uint8)
+        assert np.array_equal(cli_ground, d.reshape(-1).astype(np.uint8))
