@@ -127,3 +127,13 @@ def test_pooled_score_over_the_frames_of_a_scan():
         gt.score([frames[0], "x"], decisions)
     with pytest.raises(ValueError, match="frame: an empty list"):
         gt.score([], [])
+
+
+def test_the_readme_example():
+    # python/README.md and the package docstring: a flat-world toy loses the down ramp, nitsch keeps it.
+    (frame,) = gt.scan("ramp", "hdl64e-roof", params={"slope_deg": -12.0, "distance_m": 5.0}, mount={"z_m": 1.9})
+    points, _cells = frame.points()
+    s = gt.score(frame, abs(points[:, 2]) < 0.25, region="ramp-surface")
+    assert (s.tp, s.fn, s.returns) == (983, 4506, 5489)
+    assert round(s.recall, 2) == 0.18
+    assert gt.score(frame, gt.classify(frame, "nitsch"), region="ramp-surface").recall >= 0.95
