@@ -199,7 +199,13 @@ pub fn cell_decisions(frame: &Frame, decisions: &Bound<'_, PyAny>) -> PyResult<V
         return Err(type_error("decisions", format!("expected dtype bool, got {}", dtype.str()?)));
     }
     let arr = arr.cast::<numpy::PyArrayDyn<bool>>()?;
-    let values: Vec<bool> = arr.readonly().as_array().iter().copied().collect();
+    let values: Vec<bool> = arr
+        .try_readonly()
+        .map_err(|e| value_error("decisions", format!("the array cannot be read: {e}")))?
+        .as_array()
+        .iter()
+        .copied()
+        .collect();
     let c = frame.cloud();
     let (h, w) = frame.grid();
     let shape = arr.shape().to_vec();

@@ -126,3 +126,14 @@ def test_bad_files(frame, tmp_path):
         gt.write(frame, tmp_path / "no/such/dir/out.pcd")
     with pytest.raises(TypeError, match="path"):
         gt.read(3)
+
+
+def test_classify_an_unorganized_file_is_refused_not_crashed(tmp_path):
+    # A KITTI .bin reads back as a 1 x N cloud in file order; our methods need the grid (the
+    # command line's `classify` recovers it from real recordings first).
+    (f,) = gt.scan("flat", "vlp16-roof")
+    gt.write(f, tmp_path / "f.bin")
+    back = gt.read(tmp_path / "f.bin")
+    assert back.shape == (1, f.returns)
+    with pytest.raises(ValueError, match="too small"):
+        gt.classify(back)

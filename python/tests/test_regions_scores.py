@@ -137,3 +137,13 @@ def test_the_readme_example():
     assert (s.tp, s.fn, s.returns) == (983, 4506, 5489)
     assert round(s.recall, 2) == 0.18
     assert gt.score(frame, gt.classify(frame, "nitsch"), region="ramp-surface").recall >= 0.95
+
+
+def test_strided_and_fortran_decisions_score_like_contiguous(ramp_hdl):
+    d = gt.classify(ramp_hdl)
+    want = gt.score(ramp_hdl, d).as_dict()
+    assert gt.score(ramp_hdl, np.asfortranarray(d)).as_dict() == pytest.approx(want, nan_ok=True)
+    wide = np.zeros((d.shape[0], 2 * d.shape[1]), dtype=bool)
+    wide[:, ::2] = d
+    assert gt.score(ramp_hdl, wide[:, ::2]).as_dict() == pytest.approx(want, nan_ok=True)
+    assert gt.score(ramp_hdl, d[::-1][::-1]).as_dict() == pytest.approx(want, nan_ok=True)
