@@ -117,8 +117,9 @@ fn _time_rust_scan(py: Python<'_>, scene: &str, rig: &str, repeats: usize, ideal
     .map_err(scenario_error)
 }
 
-/// The native part of the `groundtruth` package.
-#[pymodule]
+/// The native part of the `groundtruth` package. Safe without the GIL (free-threaded Python): the
+/// classes are frozen and hold immutable, shared (`Arc`) Rust data.
+#[pymodule(gil_used = false)]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("SCENES", scenes::bundled_names())?;
