@@ -94,7 +94,7 @@ pub(crate) fn neighbours(view: &GridView<'_>, bits: &ReturnBits, r: usize, c: us
     out[2] = first_along(own, REACH, 1, gap).map(|b| cell(r, b));
     out[6] = first_along(own, REACH, -1, gap).map(|b| cell(r, b));
     // The nearest row above (below) with a return near the column, skipping empty rows.
-    let mut side = |row: usize, centre: usize, right: usize, left: usize| -> bool {
+    let side = |row: usize, out: &mut [Option<usize>; 8], [centre, right, left]: [usize; 3]| -> bool {
         let w = bits.window(row, c0);
         let Some(b) = nearest(w, gap) else { return false };
         out[centre] = Some(cell(row, b));
@@ -102,8 +102,16 @@ pub(crate) fn neighbours(view: &GridView<'_>, bits: &ReturnBits, r: usize, c: us
         out[left] = first_along(w, b, -1, gap).map(|x| cell(row, x));
         true
     };
-    let _ = (r + 1..rows.min(r + 1 + MAX_ROW_GAP)).any(|up| side(up, 0, 1, 7));
-    let _ = (r.saturating_sub(MAX_ROW_GAP)..r).rev().any(|dn| side(dn, 4, 3, 5));
+    for up in r + 1..rows.min(r + 1 + MAX_ROW_GAP) {
+        if side(up, &mut out, [0, 1, 7]) {
+            break;
+        }
+    }
+    for dn in (r.saturating_sub(MAX_ROW_GAP)..r).rev() {
+        if side(dn, &mut out, [4, 3, 5]) {
+            break;
+        }
+    }
     out
 }
 
