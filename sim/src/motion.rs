@@ -38,18 +38,27 @@ impl VehiclePose {
     }
 }
 
-/// Constant speed and yaw rate from a start pose, with terrain-following z, pitch and roll.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Constant speed and yaw rate from a start pose, or a polyline of waypoints driven at constant
+/// speed, with terrain-following z, pitch and roll.
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct Trajectory {
     /// Forward speed, metres per second.
     pub speed_m_per_s: f64,
-    /// Yaw rate, radians per second (positive: turning left).
+    /// Yaw rate, radians per second (positive: turning left); ignored with waypoints.
     pub yaw_rate_rad_per_s: f64,
+    /// Waypoints `[x, y]` in the world frame, metres (none, or 2 or more): the vehicle starts at the
+    /// first facing the second and drives along the polyline at `speed_m_per_s`, heading along the
+    /// segment it is on (it turns on the spot at a waypoint); past the last one it goes on straight.
+    pub waypoints_m: Vec<[f64; 2]>,
 }
 
 impl Trajectory {
-    /// Planar pose (x, y, yaw) at time `t_s` from the origin facing +x: a straight line or a circular arc.
+    /// Planar pose (x, y, yaw) at time `t_s`: from the origin facing +x, a straight line or a
+    /// circular arc; or the point `speed * t_s` along the waypoints' polyline.
     pub fn planar(&self, t_s: f64) -> (f64, f64, f64) {
+        if self.waypoints_m.len() >= 2 {
+            return along_polyline(&self.waypoints_m, self.speed_m_per_s * t_s);
+        }
         let (v, w) = (self.speed_m_per_s, self.yaw_rate_rad_per_s);
         let yaw = w * t_s;
         if w.abs() < 1e-9 { (v * t_s, 0.0, yaw) } else { (v / w * yaw.sin(), v / w * (1.0 - yaw.cos()), yaw) }
@@ -59,6 +68,22 @@ impl Trajectory {
     pub fn is_static(&self) -> bool {
         self.speed_m_per_s == 0.0 && self.yaw_rate_rad_per_s == 0.0
     }
+}
+
+/// The point `s_m` metres along the polyline `points` (from its first point; beyond the last point
+/// along the last segment's heading) and the heading there, radians.
+fn along_polyline(points: &[[f64; 2]], s_m: f64) -> (f64, f64, f64) {
+    let mut left = s_m.max(0.0);
+    for (k, w) in points.windows(2).enumerate() {
+        let (dx, dy) = (w[1][0] - w[0][0], w[1][1] - w[0][1]);
+        let len = dx.hypot(dy);
+        if left <= len || k + 2 == points.len() {
+            let u = if len > 0.0 { left / len } else { 0.0 };
+            return (w[0][0] + u * dx, w[0][1] + u * dy, dy.atan2(dx));
+        }
+        left -= len;
+    }
+    (points[0][0], points[0][1], 0.0)
 }
 
 /// Settles a planar pose on the terrain: casts vertical rays at the four wheels (from `z_hint_m + 2 m`
@@ -157,12 +182,31 @@ mod tests {
 
     #[test]
     fn circular_arc_keeps_radius_and_heading() {
-        let tr = Trajectory { speed_m_per_s: 10.0, yaw_rate_rad_per_s: 0.5 };
+        let tr = Trajectory { speed_m_per_s: 10.0, yaw_rate_rad_per_s: 0.5, ..Default::default() };
         let (x, y, yaw) = tr.planar(std::f64::consts::PI); // half a turn... yaw = pi/2
         let r = 10.0 / 0.5;
         assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         assert!((x - r).abs() < 1e-9 && (y - r).abs() < 1e-9, "({x}, {y})");
-        let (x, y, _) = Trajectory { speed_m_per_s: 3.0, yaw_rate_rad_per_s: 0.0 }.planar(2.0);
+        let (x, y, _) = Trajectory { speed_m_per_s: 3.0, ..Default::default() }.planar(2.0);
         assert_eq!((x, y), (6.0, 0.0));
+    }
+
+    #[test]
+    fn waypoints_are_followed_at_speed() {
+        let tr = Trajectory {
+            speed_m_per_s: 2.0,
+            waypoints_m: vec![[1.0, 1.0], [4.0, 5.0], [4.0, 9.0]],
+            ..Default::default()
+        };
+        // Segment 1 is 5 m long (3-4-5), segment 2 4 m.
+        let (x, y, yaw) = tr.planar(1.0);
+        assert!((x - 2.2).abs() < 1e-12 && (y - 2.6).abs() < 1e-12, "({x}, {y})");
+        assert!((yaw - 4f64.atan2(3.0)).abs() < 1e-12);
+        let (x, y, yaw) = tr.planar(3.5); // 7 m: 2 m into segment 2
+        assert!((x - 4.0).abs() < 1e-12 && (y - 7.0).abs() < 1e-12, "({x}, {y})");
+        assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        let (x, y, _) = tr.planar(6.0); // 12 m: 3 m past the end, straight on
+        assert!((x - 4.0).abs() < 1e-12 && (y - 12.0).abs() < 1e-12, "({x}, {y})");
+        assert_eq!(tr.planar(0.0), (1.0, 1.0, 4f64.atan2(3.0)));
     }
 }

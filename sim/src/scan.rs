@@ -54,6 +54,9 @@ pub struct ScanConfig {
     pub backend: Backend,
     /// Height of the ground under the ego vehicle at the start, metres (a hint for terrain following).
     pub ego_z_m: f32,
+    /// Waypoints `[x, y]` the ego follows at `speed_m_per_s` (world frame, metres; none, or 2 or
+    /// more): see [`crate::motion::Trajectory::waypoints_m`]. The yaw rate is then unused.
+    pub waypoints_m: Vec<[f64; 2]>,
 }
 
 impl Default for ScanConfig {
@@ -66,6 +69,7 @@ impl Default for ScanConfig {
             ideal: false,
             backend: Backend::Bvh,
             ego_z_m: 0.0,
+            waypoints_m: Vec::new(),
         }
     }
 }
@@ -78,7 +82,22 @@ impl ScanConfig {
         }
         check_range("speed_m_per_s", f64::from(self.speed_m_per_s), -100.0, 100.0)?;
         check_range("yaw_rate_rad_per_s", f64::from(self.yaw_rate_rad_per_s), -2.0, 2.0)?;
-        check_range("ego_z_m", f64::from(self.ego_z_m), -10_000.0, 10_000.0)
+        check_range("ego_z_m", f64::from(self.ego_z_m), -10_000.0, 10_000.0)?;
+        match self.waypoints_m.len() {
+            0 => Ok(()),
+            1 => Err(SimError::invalid("waypoints_m", 1, "none, or 2 or more points")),
+            _ if !(self.speed_m_per_s > 0.0) => {
+                Err(SimError::invalid("speed_m_per_s", self.speed_m_per_s, "> 0 with waypoints"))
+            }
+            _ => {
+                for (k, w) in self.waypoints_m.iter().enumerate() {
+                    for v in w {
+                        check_range(&format!("waypoints_m[{k}]"), *v, -1e6, 1e6)?;
+                    }
+                }
+                Ok(())
+            }
+        }
     }
 }
 
@@ -205,6 +224,7 @@ impl<'a> Scanner<'a> {
         let trajectory = Trajectory {
             speed_m_per_s: f64::from(config.speed_m_per_s),
             yaw_rate_rad_per_s: f64::from(config.yaw_rate_rad_per_s),
+            waypoints_m: config.waypoints_m.clone(),
         };
         let track =
             PoseTrack::new(caster.as_ref(), trajectory, frame_period_s, config.frames, f64::from(config.ego_z_m));

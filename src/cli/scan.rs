@@ -106,6 +106,7 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         ideal: args.ideal,
         backend,
         ego_z_m: scene.ego_ground_z_m,
+        waypoints_m: Vec::new(),
     };
     let scanner = Scanner::new(&scene.mesh, &rig, config)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating output directory {}", args.out.display()))?;
