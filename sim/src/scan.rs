@@ -86,7 +86,7 @@ impl ScanConfig {
         match self.waypoints_m.len() {
             0 => Ok(()),
             1 => Err(SimError::invalid("waypoints_m", 1, "none, or 2 or more points")),
-            _ if !(self.speed_m_per_s > 0.0) => {
+            _ if self.speed_m_per_s <= 0.0 => {
                 Err(SimError::invalid("speed_m_per_s", self.speed_m_per_s, "> 0 with waypoints"))
             }
             _ => {
