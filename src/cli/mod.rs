@@ -5,6 +5,7 @@ mod bench_classify;
 mod bench_scan;
 mod classify;
 mod common;
+mod dataset;
 mod demo;
 mod eval;
 mod eval_paper;
@@ -49,6 +50,8 @@ enum Command {
     Train(train::Args),
     /// Sensor-mount sensitivity sweeps: run (sharded, resumable), merge, plot, report.
     Sweep(sweep::Args),
+    /// Labelled scans as a SemanticKITTI-layout dataset (sharded, resumable), or `verify DIR`.
+    Dataset(dataset::Args),
     /// Benchmarks that print one JSON object.
     #[command(subcommand)]
     Bench(bench::Command),
@@ -66,6 +69,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Eval(a) => eval::run(a),
         Command::Train(a) => train::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Dataset(a) => dataset::run(a),
         Command::Bench(c) => bench::run(c),
     }
 }
