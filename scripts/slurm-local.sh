@@ -11,7 +11,9 @@
 #    ProctrackType=proctrack/linuxproc, TaskPlugin=task/none, no accounting; slurmctld and slurmd;
 # 4. the sweep unsharded, then `sbatch --array=0-3 --wait deploy/slurm/sweep.sbatch`, then
 #    `groundtruth sweep merge`;
-# 5. the sorted results.csv and results.jsonl of both compared byte for byte.
+# 5. the sorted results.csv and results.jsonl of both compared byte for byte;
+# 6. examples/dataset-semantickitti.toml as a dataset, unsharded and as a 3-task array
+#    (`sweep.sbatch --job dataset`) into one directory, compared with `diff -r`, then verified.
 # Exits non-zero on any failure or difference. The daemons this script started are stopped at the
 # end unless KEEP_SLURM=1. Work files go to $WORK (default a temporary directory, removed).
 set -euo pipefail
@@ -150,5 +152,23 @@ for f in results.csv results.jsonl; do
     status=1
   fi
 done
+# 6. The bundled SemanticKITTI-layout dataset: unsharded, then as a 3-task array into one
+# directory (no merge step); the trees must be equal byte for byte.
+dataset=$repo/examples/dataset-semantickitti.toml
+log "unsharded dataset $dataset"
+"$bin" dataset --config "$dataset" --out "$work/dataset-whole" >/dev/null
+log "3-task dataset job array"
+GROUNDTRUTH=$bin timeout "${ARRAY_TIMEOUT_S:-900}" sbatch --wait --array=0-2 --cpus-per-task=1 \
+  --output="$work/logs/dataset-%A_%a.out" deploy/slurm/sweep.sbatch --job dataset "$dataset" "$work/dataset-array"
+for f in "$work"/logs/dataset-*.out; do
+  grep -q '"frames_written"' "$f" || { echo "dataset array task failed: $f" >&2; cat "$f" >&2; exit 1; }
+done
+if diff -r "$work/dataset-whole" "$work/dataset-array" >/dev/null; then
+  log "dataset: 3-task array = unsharded ($(find "$work/dataset-array" -name '*.bin' | wc -l) frames); verify:"
+  "$bin" dataset verify "$work/dataset-array" | tail -n 1
+else
+  log "dataset: the 3-task array DIFFERS from the unsharded run"
+  status=1
+fi
 log "done in $(( $(date +%s) - start )) s"
 exit $status
