@@ -1,0 +1,102 @@
+//! The cells whose neighbours are not all their direct grid neighbours: the grid's first and last
+//! rows and blocks, and cells next to a missing return, whose neighbours come from the general
+//! search ([`crate::nitsch::return_bits`]) and whose pair normals are their own cross products.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::*;
+use crate::nitsch::return_bits;
+
+/// The `m` cells of row `r` from column `c0` on, by the general neighbour search.
+#[inline(always)]
+pub(super) fn general_block(
+    plane: &Plane<'_>,
+    r: usize,
+    c0: usize,
+    m: usize,
+    lanes: &mut Lanes,
+    out: &mut Outputs<'_>,
+) {
+    let i0 = r * plane.view.cols + c0;
+    if !plane.valid[i0..i0 + m].iter().any(|&v| v) {
+        // No return in these cells (sky): no features.
+        out.zero(i0, m);
+        return;
+    }
+    let direct = direct_lanes(plane, r, c0, m, lanes);
+    let mut cell_ok = [false; L];
+    for l in 0..m {
+        cell_ok[l] = direct[l] || fill_one(plane, r, c0 + l, l, lanes);
+    }
+    let mut f = Cells::default();
+    lane_features(lanes, plane.min_pairs, &mut f);
+    out.write(i0, m, &cell_ok, &f);
+}
+
+/// Fills the lanes of those of the `m` cells from `(r, c0)` on whose neighbours are their direct
+/// grid neighbours, lane-wise, and says which: cells off the first and last column whose row, and
+/// the rows above and below where the grid has them, hold returns in the cell's column and the
+/// columns either side. [`GridView::neighbours`] then finds exactly those (a missing row above or
+/// below has no neighbours), so the lanes get the values [`fill_one`] would give them.
+#[inline(always)]
+fn direct_lanes(plane: &Plane<'_>, r: usize, c0: usize, m: usize, lanes: &mut Lanes) -> [bool; L] {
+    let (rows, cols) = (plane.view.rows, plane.view.cols);
+    // Rows r - 1, r, r + 1 over columns c0 - 1 ..= c0 + L: x, y, z, range and return flags.
+    let mut win = [[[0f32; L + 2]; 3]; 4];
+    let mut has = [[false; L + 2]; 3];
+    let exists = [r > 0, true, r + 1 < rows];
+    let (lo, hi) = (c0.max(1) - 1, (c0 + L + 1).min(cols));
+    let w = lo + 1 - c0..hi + 1 - c0;
+    for dr in 0..3 {
+        if exists[dr] {
+            let row = (r + dr - 1) * cols;
+            let src = row + lo..row + hi;
+            for (a, plane_a) in [plane.x, plane.y, plane.z, plane.view.ranges].into_iter().enumerate() {
+                win[a][dr][w.clone()].copy_from_slice(&plane_a[src.clone()]);
+            }
+            has[dr][w.clone()].copy_from_slice(&plane.valid[src]);
+        }
+    }
+    let mut direct = [false; L];
+    for l in 0..m.min(L) {
+        let c = c0 + l;
+        let rows_ok = (0..3).all(|dr| !exists[dr] || (has[dr][l] & has[dr][l + 1] & has[dr][l + 2]));
+        direct[l] = c > 0 && c + 1 < cols && rows_ok;
+    }
+    let lane = |a: usize, dr: usize, off: usize| -> [f32; L] { win[a][dr][off..off + L].try_into().expect("L lanes") };
+    let (px, py, pz, pr) = (lane(0, 1, 1), lane(1, 1, 1), lane(2, 1, 1), lane(3, 1, 1));
+    for (k, &(dr, dc)) in OFFSETS.iter().enumerate() {
+        let (wr, off) = ((1 + dr) as usize, (1 + dc) as usize);
+        let (qx, qy, qz, qr) = (lane(0, wr, off), lane(1, wr, off), lane(2, wr, off), lane(3, wr, off));
+        for l in 0..L {
+            // The operations of `fill_one`: a dropped or missing neighbour gets zeros.
+            let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
+            let keep = exists[wr] & plane.tests.keep(k, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], qr[l], pr[l]);
+            let d = if keep { d } else { [0.0; 3] };
+            (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
+            lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
+            lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        }
+    }
+    direct
+}
+
+/// Offsets of cell `(r, c)` into lane `l` by the general neighbour search; false if it has no return.
+#[inline]
+pub(super) fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &mut Lanes) -> bool {
+    let (view, tests, ranges) = (plane.view, &plane.tests, plane.view.ranges);
+    let i = r * view.cols + c;
+    let nb = if plane.valid[i] { return_bits::neighbours(view, plane.bits, r, c) } else { [None; 8] };
+    for (k, j) in nb.into_iter().enumerate() {
+        let (mut d, mut ok) = ([0.0; 3], 0.0);
+        if let Some(j) = j {
+            let dj = [plane.x[j] - plane.x[i], plane.y[j] - plane.y[i], plane.z[j] - plane.z[i]];
+            if tests.keep(k, dj[0] * dj[0] + dj[1] * dj[1] + dj[2] * dj[2], ranges[j], ranges[i]) {
+                (d, ok) = (dj, 1.0);
+            }
+        }
+        (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l], lanes.ok[k][l]) = (d[0], d[1], d[2], ok);
+        lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    }
+    plane.valid[i]
+}
