@@ -97,6 +97,38 @@ pub struct BvhCaster {
     pad_m: f32,
 }
 
+/// Padding of every primitive box of `mesh`'s BVH, metres (see the module docs).
+pub(crate) fn pad_for(mesh: &SceneMesh) -> f32 {
+    match mesh.bounds() {
+        Some((lo, hi)) => 4e-6 * (lo.abs().max(hi.abs()).max_element() + (hi - lo).length()) + 1e-6,
+        None => 0.0,
+    }
+}
+
+/// The obvhs BVH2 (PLOC build, then reinsertion when `reinsertion_ratio > 0`) over the triangles
+/// of a non-empty `mesh`, every box padded by `pad_m`; leaves of one triangle each.
+pub(crate) fn padded_bvh2(mesh: &SceneMesh, pad_m: f32, reinsertion_ratio: f32) -> Bvh2 {
+    let pad = Vec3A::splat(pad_m);
+    let aabbs: Vec<Aabb> = (0..mesh.len())
+        .map(|i| {
+            let [a, b, c] = mesh.triangle(i);
+            let (a, b, c) = (Vec3A::from(a), Vec3A::from(b), Vec3A::from(c));
+            Aabb::new(a.min(b).min(c) - pad, a.max(b).max(c) + pad)
+        })
+        .collect();
+    let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+        PlocSearchDistance::Low,
+        &aabbs,
+        (0..aabbs.len() as u32).collect(),
+        SortPrecision::U64,
+        2,
+    );
+    if reinsertion_ratio > 0.0 {
+        ReinsertionOptimizer::default().run(&mut bvh2, reinsertion_ratio, None);
+    }
+    bvh2
+}
+
 impl BvhCaster {
     /// Builds the BVH over `mesh` with the default options.
     pub fn new(mesh: &SceneMesh) -> Self {
@@ -105,31 +137,11 @@ impl BvhCaster {
 
     /// Builds the BVH over `mesh` with `options`.
     pub fn with_options(mesh: &SceneMesh, options: BvhOptions) -> Self {
-        let pad_m = match mesh.bounds() {
-            Some((lo, hi)) => 4e-6 * (lo.abs().max(hi.abs()).max_element() + (hi - lo).length()) + 1e-6,
-            None => 0.0,
-        };
+        let pad_m = pad_for(mesh);
         if mesh.is_empty() {
             return Self { tree: Tree::Empty, tris: Vec::new(), order_to_triangle: Vec::new(), options, pad_m };
         }
-        let pad = Vec3A::splat(pad_m);
-        let aabbs: Vec<Aabb> = (0..mesh.len())
-            .map(|i| {
-                let [a, b, c] = mesh.triangle(i);
-                let (a, b, c) = (Vec3A::from(a), Vec3A::from(b), Vec3A::from(c));
-                Aabb::new(a.min(b).min(c) - pad, a.max(b).max(c) + pad)
-            })
-            .collect();
-        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
-            PlocSearchDistance::Low,
-            &aabbs,
-            (0..aabbs.len() as u32).collect(),
-            SortPrecision::U64,
-            2,
-        );
-        if options.reinsertion_ratio > 0.0 {
-            ReinsertionOptimizer::default().run(&mut bvh2, options.reinsertion_ratio, None);
-        }
+        let mut bvh2 = padded_bvh2(mesh, pad_m, options.reinsertion_ratio);
         let (tree, indices) = match options.layout {
             BvhLayout::Binary => {
                 collapse(&mut bvh2, options.max_prims_per_leaf.clamp(1, 255), 3.0);

@@ -4,6 +4,8 @@
 
 mod bvh;
 pub mod fixture;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 mod reference;
 pub mod watertight;
 mod wide4;

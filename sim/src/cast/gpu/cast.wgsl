@@ -1,0 +1,170 @@
+// Closest hit of a batch of rays against a binary BVH (obvhs Bvh2 node layout, flattened on the
+// CPU), traversed with a fixed-size stack, nearer child first, with the watertight ray/triangle
+// test of `watertight.rs` (Woop, Benthin and Wald 2013) in f32 (no f64 fallback for the rare
+// exactly-zero edge functions: such rays may pick the other triangle of a shared edge).
+//
+// nodes: 2 vec4 per node: (min.xyz, prim_count bits), (max.xyz, first_index bits); an inner node
+//        (prim_count 0) has its children at first_index and first_index + 1, a leaf its triangles
+//        at first_index .. first_index + prim_count.
+// tris:  3 vec4 per triangle (corners, w unused), in leaf order.
+// rays:  2 vec4 per ray: (origin.xyz, t_max), (dir.xyz, 0).
+// hits:  per ray (t bits, leaf-order triangle), triangle 0xFFFFFFFF: miss, 0xFFFFFFFE: the stack
+//        overflowed (the host casts that ray on the CPU).
+
+struct Params {
+    count: u32,
+    first: u32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+@group(0) @binding(0) var<storage, read> nodes: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> tris: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> rays: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> hits: array<vec2<u32>>;
+@group(0) @binding(4) var<uniform> params: Params;
+
+const STACK: u32 = 64u;
+const MISS: u32 = 0xFFFFFFFFu;
+const OVERFLOW: u32 = 0xFFFFFFFEu;
+
+fn axis(v: vec3<f32>, k: u32) -> f32 {
+    if (k == 0u) {
+        return v.x;
+    }
+    if (k == 1u) {
+        return v.y;
+    }
+    return v.z;
+}
+
+// Entry distance (>= 0) of the ray into a node's box within t_best, or -1 when it misses.
+fn enter(lo: vec3<f32>, hi: vec3<f32>, o: vec3<f32>, inv: vec3<f32>, t_best: f32) -> f32 {
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
+    let tmin = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    let tmax = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), t_best));
+    return select(-1.0, tmin, tmin <= tmax);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.count) {
+        return;
+    }
+    let r = params.first + i;
+    let o = rays[2u * r].xyz;
+    var t_best = rays[2u * r].w;
+    let d = rays[2u * r + 1u].xyz;
+    // Watertight test set-up: kz the largest direction component, kx / ky the others (swapped to
+    // keep the winding when d[kz] < 0), shear sx, sy and scale sz.
+    let a = abs(d);
+    var kz = 2u;
+    if (a.x >= a.y && a.x >= a.z) {
+        kz = 0u;
+    } else if (a.y >= a.z) {
+        kz = 1u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kx + 1u) % 3u;
+    if (axis(d, kz) < 0.0) {
+        let k = kx;
+        kx = ky;
+        ky = k;
+    }
+    let sz = 1.0 / axis(d, kz);
+    let sx = axis(d, kx) * sz;
+    let sy = axis(d, ky) * sz;
+    // Slab test: zero components replaced by a tiny one of the same sign (no infinities or NaN).
+    let tiny = vec3<f32>(1.0e-30);
+    let d_safe = select(d, select(tiny, -tiny, d < vec3<f32>(0.0)), abs(d) < tiny);
+    let inv = 1.0 / d_safe;
+
+    var hit = MISS;
+    var stack: array<u32, 64>;
+    var sp = 1u;
+    stack[0] = 0u;
+    loop {
+        if (sp == 0u) {
+            break;
+        }
+        sp = sp - 1u;
+        let n = stack[sp];
+        let lo = nodes[2u * n];
+        let hi = nodes[2u * n + 1u];
+        // A box entered beyond a hit found since it was pushed is skipped.
+        if (enter(lo.xyz, hi.xyz, o, inv, t_best) < 0.0) {
+            continue;
+        }
+        let count = bitcast<u32>(lo.w);
+        let first = bitcast<u32>(hi.w);
+        if (count == 0u) {
+            if (sp + 2u > STACK) {
+                hit = OVERFLOW;
+                break;
+            }
+            // The children the ray enters, the nearer on top of the stack.
+            let c0 = first;
+            let c1 = first + 1u;
+            let e0 = enter(nodes[2u * c0].xyz, nodes[2u * c0 + 1u].xyz, o, inv, t_best);
+            let e1 = enter(nodes[2u * c1].xyz, nodes[2u * c1 + 1u].xyz, o, inv, t_best);
+            if (e0 >= 0.0 && e1 >= 0.0) {
+                if (e0 <= e1) {
+                    stack[sp] = c1;
+                    stack[sp + 1u] = c0;
+                } else {
+                    stack[sp] = c0;
+                    stack[sp + 1u] = c1;
+                }
+                sp = sp + 2u;
+            } else if (e0 >= 0.0) {
+                stack[sp] = c0;
+                sp = sp + 1u;
+            } else if (e1 >= 0.0) {
+                stack[sp] = c1;
+                sp = sp + 1u;
+            }
+            continue;
+        }
+        for (var k = 0u; k < count; k = k + 1u) {
+            let p = first + k;
+            let va = tris[3u * p].xyz - o;
+            let vb = tris[3u * p + 1u].xyz - o;
+            let vc = tris[3u * p + 2u].xyz - o;
+            let az = axis(va, kz);
+            let bz = axis(vb, kz);
+            let cz = axis(vc, kz);
+            let ax = axis(va, kx) - sx * az;
+            let ay = axis(va, ky) - sy * az;
+            let bx = axis(vb, kx) - sx * bz;
+            let by = axis(vb, ky) - sy * bz;
+            let cx = axis(vc, kx) - sx * cz;
+            let cy = axis(vc, ky) - sy * cz;
+            let u = cx * by - cy * bx;
+            let v = ax * cy - ay * cx;
+            let w = bx * ay - by * ax;
+            if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) {
+                continue;
+            }
+            let det = u + v + w;
+            if (det == 0.0) {
+                continue;
+            }
+            let ts = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
+            var in_range = ts < 0.0 && ts >= t_best * det;
+            if (det > 0.0) {
+                in_range = ts > 0.0 && ts <= t_best * det;
+            }
+            if (!in_range) {
+                continue;
+            }
+            let t = ts / det;
+            if (t > 0.0 && t <= t_best) {
+                t_best = t;
+                hit = p;
+            }
+        }
+    }
+    hits[r] = vec2<u32>(bitcast<u32>(t_best), hit);
+}

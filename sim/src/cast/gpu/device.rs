@@ -1,0 +1,111 @@
+//! Adapter and device: chosen through wgpu's environment conventions, with the adapter's own
+//! storage-buffer limits (a scene's BVH can exceed the 128 MiB default binding).
+
+use super::GpuError;
+
+/// A device, its queue and the compiled ray-casting pipeline.
+pub(super) struct Gpu {
+    pub(super) device: wgpu::Device,
+    pub(super) queue: wgpu::Queue,
+    pub(super) pipeline: wgpu::ComputePipeline,
+    pub(super) layout: wgpu::BindGroupLayout,
+    /// Largest storage binding, bytes.
+    pub(super) max_binding_bytes: u64,
+    /// Adapter name, backend and type.
+    pub(super) description: String,
+}
+
+/// The adapter wgpu's environment variables choose: `WGPU_ADAPTER_NAME` (a case-insensitive
+/// substring of the name) among the adapters of `WGPU_BACKEND`, else the default request.
+fn adapter() -> Result<wgpu::Adapter, GpuError> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
+        let want = name.to_lowercase();
+        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+        let all = pollster::block_on(instance.enumerate_adapters(backends));
+        let names: Vec<String> = all.iter().map(|a| a.get_info().name).collect();
+        return all
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&want))
+            .ok_or_else(|| GpuError::NoAdapter(format!("WGPU_ADAPTER_NAME `{name}` matches none of {names:?}")));
+    }
+    let options = wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::from_env().unwrap_or(wgpu::PowerPreference::HighPerformance),
+        ..Default::default()
+    };
+    pollster::block_on(instance.request_adapter(&options)).map_err(|e| GpuError::NoAdapter(e.to_string()))
+}
+
+/// "name (backend, device type)" of the adapter wgpu's environment variables choose.
+pub fn adapter_description() -> Result<String, GpuError> {
+    Ok(describe(&adapter()?.get_info()))
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+}
+
+impl Gpu {
+    /// Opens the device and compiles `cast.wgsl`.
+    pub(super) fn new() -> Result<Self, GpuError> {
+        let adapter = adapter()?;
+        let info = adapter.get_info();
+        let description = describe(&info);
+        let limits = adapter.limits();
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("groundtruth caster"),
+            required_limits: limits.clone(),
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|e| GpuError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("cast.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("cast.wgsl").into()),
+        });
+        let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("caster"),
+            entries: &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, true),
+                storage(3, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("caster"),
+            bind_group_layouts: &[Some(&layout)],
+            ..Default::default()
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("cast"),
+            layout: Some(&pipeline_layout),
+            module: &shader,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let max_binding_bytes = u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        Ok(Self { device, queue, pipeline, layout, max_binding_bytes, description })
+    }
+}
