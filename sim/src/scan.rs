@@ -155,16 +155,17 @@ pub struct PreparedScene {
 }
 
 impl PreparedScene {
-    /// Builds `backend`'s acceleration structure and the triangle records of `mesh`.
-    pub fn new(mesh: &SceneMesh, backend: Backend) -> Self {
+    /// Builds `backend`'s acceleration structure and the triangle records of `mesh` (fails only for
+    /// a GPU backend that cannot start).
+    pub fn new(mesh: &SceneMesh, backend: Backend) -> Result<Self> {
         let (triangles, surfaces) = triangle_records(mesh);
-        Self {
+        Ok(Self {
             backend,
             triangle_count: mesh.len(),
-            caster: Arc::from(backend.build(mesh)),
+            caster: Arc::from(backend.build(mesh)?),
             triangles: Arc::new(triangles),
             surfaces: Arc::new(surfaces),
-        }
+        })
     }
 }
 
@@ -180,7 +181,7 @@ impl<'a> Scanner<'a> {
         config.validate()?;
         rig.validate()?;
         mesh.validate().map_err(|m| SimError::invalid("scene mesh", m, "finite vertices, valid indices"))?;
-        let prepared = PreparedScene::new(mesh, config.backend);
+        let prepared = PreparedScene::new(mesh, config.backend)?;
         Self::with_prepared(mesh, rig, config, &prepared)
     }
 
@@ -852,7 +853,7 @@ mod tests {
         let rig = Rig::preset("lux-roof-4").unwrap();
         let config = ScanConfig { seed: 3, ..Default::default() };
         let fresh = Scanner::new(&mesh, &rig, config.clone()).unwrap().frame(0);
-        let prepared = PreparedScene::new(&mesh, Backend::Bvh);
+        let prepared = PreparedScene::new(&mesh, Backend::Bvh).unwrap();
         let mut moved = rig.clone();
         moved.sensors[0].mount.z_m += 0.3;
         let shared = Scanner::with_prepared(&mesh, &rig, config.clone(), &prepared).unwrap().frame(0);

@@ -68,6 +68,8 @@ enum BackendArg {
     Bvh,
     /// parry3d BVH (reference).
     Parry,
+    /// wgpu compute shaders (feature `gpu`; the adapter as `WGPU_BACKEND` / `WGPU_ADAPTER_NAME` choose).
+    Gpu,
 }
 
 /// Runs the benchmark and prints one JSON object.
@@ -105,11 +107,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let backend = match a.backend {
         BackendArg::Bvh => Backend::Bvh,
         BackendArg::Parry => Backend::Parry,
+        BackendArg::Gpu => Backend::Gpu,
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads).build().context("starting the thread pool")?;
     let threads = pool.current_num_threads();
     let t0 = Instant::now();
-    let caster = pool.install(|| backend.build(&mesh));
+    let caster = pool.install(|| backend.build(&mesh))?;
     let build_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let cpu0 = process_cpu_s();

@@ -1,4 +1,5 @@
-//! `groundtruth list`: the scenes, rigs and classification methods this build knows.
+//! `groundtruth list`: the scenes, rigs, classification methods and casting backends this build
+//! knows, with the GPU adapter the `gpu` backend would use.
 
 /// Arguments of `groundtruth list`.
 #[derive(clap::Args, Debug)]
@@ -18,5 +19,14 @@ pub fn run(_args: Args) -> anyhow::Result<()> {
     for name in classifier::METHODS {
         println!("  {name}");
     }
+    println!("casting backends:");
+    println!("  bvh (production), parry (reference)");
+    #[cfg(feature = "gpu")]
+    match sim::cast::gpu::adapter_description() {
+        Ok(adapter) => println!("  gpu: {adapter}"),
+        Err(e) => println!("  gpu: unavailable: {e}"),
+    }
+    #[cfg(not(feature = "gpu"))]
+    println!("  gpu: not in this build (cargo feature `gpu`)");
     Ok(())
 }

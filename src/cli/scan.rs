@@ -48,7 +48,8 @@ pub struct Args {
     /// Worker threads (default: all cores). Results are identical at any count.
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Ray casting backend: bvh (production) or parry (reference).
+    /// Ray casting backend: bvh (production), parry (reference) or gpu (wgpu; the adapter as
+    /// `WGPU_BACKEND` / `WGPU_ADAPTER_NAME` choose).
     #[arg(long, default_value = "bvh")]
     pub backend: String,
 }
@@ -58,7 +59,8 @@ pub fn parse_backend(name: &str) -> anyhow::Result<Backend> {
     match name {
         "bvh" => Ok(Backend::Bvh),
         "parry" => Ok(Backend::Parry),
-        other => anyhow::bail!("unknown --backend `{other}`; allowed: bvh, parry"),
+        "gpu" => Ok(Backend::Gpu),
+        other => anyhow::bail!("unknown --backend `{other}`; allowed: bvh, parry, gpu"),
     }
 }
 

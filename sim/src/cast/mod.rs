@@ -45,6 +45,9 @@ pub enum Backend {
     Bvh,
     /// parry3d TriMesh queries with the same watertight test: the reference backend.
     Parry,
+    /// wgpu compute shaders on the GPU wgpu's environment variables choose (feature `gpu`;
+    /// [`gpu::GpuCaster`]).
+    Gpu,
 }
 
 impl Backend {
@@ -53,14 +56,25 @@ impl Backend {
         match self {
             Backend::Bvh => "obvhs-bvh",
             Backend::Parry => "parry3d",
+            Backend::Gpu => "wgpu",
         }
     }
 
-    /// Builds this backend's acceleration structure over `mesh`.
-    pub fn build(self, mesh: &SceneMesh) -> Box<dyn Caster> {
+    /// Builds this backend's acceleration structure over `mesh`; the GPU backend fails without an
+    /// adapter, or in a build without the `gpu` feature.
+    pub fn build(self, mesh: &SceneMesh) -> crate::error::Result<Box<dyn Caster>> {
         match self {
-            Backend::Bvh => Box::new(BvhCaster::new(mesh)),
-            Backend::Parry => Box::new(ParryCaster::new(mesh)),
+            Backend::Bvh => Ok(Box::new(BvhCaster::new(mesh))),
+            Backend::Parry => Ok(Box::new(ParryCaster::new(mesh))),
+            #[cfg(feature = "gpu")]
+            Backend::Gpu => match gpu::GpuCaster::new(mesh) {
+                Ok(c) => Ok(Box::new(c)),
+                Err(e) => Err(crate::error::SimError::invalid("backend", "gpu", e.to_string())),
+            },
+            #[cfg(not(feature = "gpu"))]
+            Backend::Gpu => {
+                Err(crate::error::SimError::invalid("backend", "gpu", "bvh or parry: this build has no `gpu` feature"))
+            }
         }
     }
 }

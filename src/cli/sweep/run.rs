@@ -94,7 +94,7 @@ pub fn run(space: &Space, out: &Path, shard: Shard, resume: bool, threads: usize
         let (scene, prepared) = pool.install(|| -> anyhow::Result<_> {
             let scene = crate::cli::common::load_scene_full(scene_name, seed)
                 .with_context(|| format!("scene `{scene_name}` seed {seed}"))?;
-            let prepared = PreparedScene::new(&scene.mesh, sim::cast::Backend::Bvh);
+            let prepared = PreparedScene::new(&scene.mesh, sim::cast::Backend::Bvh)?;
             Ok((scene, prepared))
         })?;
         prepare_s += t.elapsed().as_secs_f64();

@@ -105,7 +105,7 @@ impl Gpu {
             compilation_options: Default::default(),
             cache: None,
         });
-        let max_binding_bytes = u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        let max_binding_bytes = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         Ok(Self { device, queue, pipeline, layout, max_binding_bytes, description })
     }
 }
