@@ -1,5 +1,6 @@
 //! `groundtruth scan --backend gpu` writes the same files as `--backend bvh` (on Mesa's lavapipe in
-//! CI). Without a GPU adapter the test is skipped with a message, unless
+//! CI), for a moving vehicle (rays uploaded every frame) and a standing one (rays kept on the
+//! device after the first frame). Without a GPU adapter the test is skipped with a message, unless
 //! `GROUNDTRUTH_REQUIRE_GPU=1` makes that a failure.
 
 use std::process::Command;
@@ -10,15 +11,15 @@ const BIN: &str = env!("CARGO_BIN_EXE_groundtruth");
 fn gpu_scan_writes_the_bvh_scans_files() {
     let dir = std::env::temp_dir().join(format!("gt-gpu-scan-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let scan = |backend: &str| {
+    let scan = |backend: &str, speed: &str| {
         Command::new(BIN)
-            .args(["scan", "--scene", "flat-objects", "--rig", "vlp16-roof", "--frames", "2", "--speed", "5"])
+            .args(["scan", "--scene", "flat-objects", "--rig", "vlp16-roof", "--frames", "2", "--speed", speed])
             .args(["--format", "kitti,pcd", "--backend", backend, "--out"])
-            .arg(dir.join(backend))
+            .arg(dir.join(format!("{backend}-{speed}")))
             .output()
             .unwrap()
     };
-    let gpu = scan("gpu");
+    let gpu = scan("gpu", "5");
     if !gpu.status.success() {
         let err = String::from_utf8_lossy(&gpu.stderr);
         assert!(
@@ -28,16 +29,20 @@ fn gpu_scan_writes_the_bvh_scans_files() {
         eprintln!("skipped: {err}");
         return;
     }
-    assert!(scan("bvh").status.success());
-    for k in 0..2 {
-        for ext in ["bin", "label", "pcd"] {
-            let name = format!("frame_{k:06}.{ext}");
-            let (a, b) = (
-                std::fs::read(dir.join("gpu").join(&name)).unwrap(),
-                std::fs::read(dir.join("bvh").join(&name)).unwrap(),
-            );
-            assert!(a.len() > 1000, "{name}");
-            assert!(a == b, "{name} differs between --backend gpu and --backend bvh");
+    for (backend, speed) in [("bvh", "5"), ("gpu", "0"), ("bvh", "0")] {
+        assert!(scan(backend, speed).status.success());
+    }
+    for speed in ["5", "0"] {
+        for k in 0..2 {
+            for ext in ["bin", "label", "pcd"] {
+                let name = format!("frame_{k:06}.{ext}");
+                let (a, b) = (
+                    std::fs::read(dir.join(format!("gpu-{speed}")).join(&name)).unwrap(),
+                    std::fs::read(dir.join(format!("bvh-{speed}")).join(&name)).unwrap(),
+                );
+                assert!(a.len() > 1000, "{name}");
+                assert!(a == b, "{name} at speed {speed} differs between --backend gpu and --backend bvh");
+            }
         }
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -136,6 +136,9 @@ pub struct Scanner<'a> {
     shot_times: Vec<ShotTimes>,
     /// For a standing vehicle, every merged row's beams and rays (the same in every frame), built once.
     static_beams: Option<Vec<RowBeams>>,
+    /// For a standing vehicle and a caster that takes whole frames: the rays of every row in order,
+    /// and the key under which the caster keeps them ([`Caster::cast_all_resident`]).
+    static_ray_set: Option<(u64, Vec<Ray>)>,
     planes: usize,
     track: PoseTrack,
     frame_period_s: f64,
@@ -245,16 +248,21 @@ impl<'a> Scanner<'a> {
             frame_period_s,
             config,
             static_beams: None,
+            static_ray_set: None,
             shot_times,
         };
         if scanner.track.is_static() {
-            let cached = (0..scanner.layout.rows)
+            let cached: Vec<RowBeams> = (0..scanner.layout.rows)
                 .map(|row| {
                     let mut beams = RowBeams::default();
                     scanner.fill_row_beams(0, row, &mut beams, &[]);
                     beams
                 })
                 .collect();
+            if scanner.caster.prefers_frames() {
+                let rays = cached.iter().flat_map(|b: &RowBeams| b.rays.iter().copied()).collect();
+                scanner.static_ray_set = Some((crate::cast::new_ray_set_key(), rays));
+            }
             scanner.static_beams = Some(cached);
         }
         Ok(scanner)
@@ -335,6 +343,10 @@ impl<'a> Scanner<'a> {
             // Scratch buffers are reused across the rows one worker scans; they never carry data
             // from one row to the next (each row overwrites what it reads), so the output does not
             // depend on how rows are split among threads.
+            if self.caster.prefers_frames() {
+                let extra = self.scan_frame_at_once(index, start_time_s, cloud, &shot_poses);
+                return self.finish_frame(cloud, extra);
+            }
             row_views(cloud)
                 .into_par_iter()
                 .enumerate()
@@ -343,6 +355,11 @@ impl<'a> Scanner<'a> {
                 })
                 .collect()
         };
+        self.finish_frame(cloud, extra);
+    }
+
+    /// Writes the second and later echoes of a frame into `cloud`.
+    fn finish_frame(&self, cloud: &mut OrderedCloud, extra: Vec<Vec<ExtraEcho>>) {
         for e in extra.into_iter().flatten() {
             let i = cloud.index(usize::from(e.echo), e.row, e.col);
             e.cell.write(cloud, i, e.echo);
@@ -464,12 +481,6 @@ impl<'a> Scanner<'a> {
         scratch: &mut RowScratch,
         shot_poses: &[Vec<ShotPose>],
     ) -> Vec<ExtraEcho> {
-        let (s, ring) = self.row_source[row];
-        let pattern = &self.patterns[s];
-        // A local copy: its fields are loop invariants the compiler can hoist (through a reference it
-        // must assume the cell writes may change them).
-        let m = &{ self.measurements[s] };
-        let vehicle_from_sensor = self.vehicle_from_sensor[s];
         let RowScratch { beams, hits, echoes } = scratch;
         let beams = match &self.static_beams {
             Some(cached) => &cached[row],
@@ -478,12 +489,78 @@ impl<'a> Scanner<'a> {
                 beams
             }
         };
+        // No clearing: `cast_batch` writes every entry (its contract), so only new entries are filled.
+        hits.resize(beams.rays.len(), None);
+        self.caster.cast_batch(&beams.rays, hits);
+        self.measure_row(frame, start_time_s, row, view, beams, hits, echoes, shot_poses)
+    }
+
+    /// Scans a frame whose rays the caster takes all at once ([`Caster::prefers_frames`]): every
+    /// row's beams (cached for a standing vehicle, whose rays the caster keeps under
+    /// `static_ray_set`), one cast, then every row measured from its hits as [`Scanner::scan_row`]
+    /// does, so the cloud is the same.
+    fn scan_frame_at_once(
+        &self,
+        frame: usize,
+        start_time_s: f64,
+        cloud: &mut OrderedCloud,
+        shot_poses: &[Vec<ShotPose>],
+    ) -> Vec<Vec<ExtraEcho>> {
+        use rayon::prelude::*;
+        let built: Vec<RowBeams>;
+        let (beams, hits) = match (&self.static_beams, &self.static_ray_set) {
+            (Some(cached), Some((key, rays))) => (cached.as_slice(), self.caster.cast_all_resident(*key, rays)),
+            _ => {
+                built = (0..self.layout.rows)
+                    .into_par_iter()
+                    .map(|row| {
+                        let mut beams = RowBeams::default();
+                        self.fill_row_beams(frame, row, &mut beams, shot_poses);
+                        beams
+                    })
+                    .collect();
+                let rays: Vec<Ray> = built.iter().flat_map(|b| b.rays.iter().copied()).collect();
+                (built.as_slice(), self.caster.cast_all(&rays))
+            }
+        };
+        let mut first = Vec::with_capacity(beams.len() + 1);
+        first.push(0);
+        for b in beams {
+            first.push(first.last().copied().unwrap_or(0) + b.rays.len());
+        }
+        row_views(cloud)
+            .into_par_iter()
+            .enumerate()
+            .map_init(Vec::new, |echoes, (row, mut view)| {
+                let hits = &hits[first[row]..first[row + 1]];
+                self.measure_row(frame, start_time_s, row, &mut view, &beams[row], hits, echoes, shot_poses)
+            })
+            .collect()
+    }
+
+    /// Writes every plane-0 cell of merged row `row` from its beams and their hits (see
+    /// [`Scanner::scan_row`]); returns second and later echoes.
+    #[allow(clippy::too_many_arguments)]
+    fn measure_row(
+        &self,
+        frame: usize,
+        start_time_s: f64,
+        row: usize,
+        view: &mut RowView<'_>,
+        beams: &RowBeams,
+        hits: &[Option<Hit>],
+        echoes: &mut Vec<(f32, Hit, u32)>,
+        shot_poses: &[Vec<ShotPose>],
+    ) -> Vec<ExtraEcho> {
+        let (s, ring) = self.row_source[row];
+        let pattern = &self.patterns[s];
+        // A local copy: its fields are loop invariants the compiler can hoist (through a reference it
+        // must assume the cell writes may change them).
+        let m = &{ self.measurements[s] };
+        let vehicle_from_sensor = self.vehicle_from_sensor[s];
         let RowBeams { rays, beam_shot, beam_of_col, sub_rays, static_pose: static_world_from_sensor, beam_col } =
             beams;
         let (sub_rays, static_world_from_sensor) = (*sub_rays, *static_world_from_sensor);
-        // No clearing: `cast_batch` writes every entry (its contract), so only new entries are filled.
-        hits.resize(rays.len(), None);
-        self.caster.cast_batch(rays, hits);
 
         let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
         let mut extra = Vec::new();

@@ -316,27 +316,25 @@ fn empty_scene_never_hits() {
     assert_eq!(BvhCaster::new(&mesh).cast_all(&[r; 3]), vec![None; 3]);
 }
 
-/// The wgpu backend against the production BVH on the random scene and on a spinning sensor's
-/// rays: hit / miss identical on at least 99.99 % of the rays, distances within 1e-3 m, the same
-/// triangle except where the two are tied. No adapter: skipped with a message, unless
-/// `GROUNDTRUTH_REQUIRE_GPU=1` (CI, on Mesa's lavapipe) makes it a failure.
+/// The GPU caster, or `None` (skipped, with a message) without an adapter unless
+/// `GROUNDTRUTH_REQUIRE_GPU=1` (CI, on Mesa's lavapipe) makes that a failure.
 #[cfg(feature = "gpu")]
-#[test]
-fn gpu_matches_bvh() {
+fn gpu_caster(mesh: &SceneMesh, options: sim::cast::gpu::GpuOptions) -> Option<sim::cast::gpu::GpuCaster> {
     use sim::cast::gpu::{GpuCaster, GpuError};
-    let mesh = random_scene(7);
-    let gpu = match GpuCaster::new(&mesh) {
-        Ok(g) => g,
+    match GpuCaster::with_options(mesh, options) {
+        Ok(g) => Some(g),
         Err(e @ GpuError::NoAdapter(_)) if std::env::var("GROUNDTRUTH_REQUIRE_GPU").as_deref() != Ok("1") => {
-            eprintln!("gpu_matches_bvh skipped: {e}");
-            return;
+            eprintln!("GPU test skipped: {e}");
+            None
         }
         Err(e) => panic!("GPU backend: {e}"),
-    };
-    eprintln!("adapter: {}", gpu.adapter());
-    let cpu = BvhCaster::new(&mesh);
+    }
+}
+
+/// Random rays and a sensor 4 m above the random scene's terrain: 32 rings x 1,024 columns.
+#[cfg(feature = "gpu")]
+fn gpu_test_rays() -> Vec<Ray> {
     let mut rays = random_rays(11, 60_000);
-    // A sensor 1.8 m above the terrain: 32 rings x 1,024 columns, every ring fully round.
     for ring in 0..32 {
         let elevation = (-25.0f32 + ring as f32 * 1.2).to_radians();
         for col in 0..1024 {
@@ -345,10 +343,21 @@ fn gpu_matches_bvh() {
             rays.push(Ray { origin: Vec3::new(0.3, -0.2, 4.0), dir, t_max: 120.0 });
         }
     }
-    let expected = cpu.cast_all(&rays);
-    let got = gpu.cast_all(&rays);
+    rays
+}
+
+/// Asserts the GPU's hits `got` against the CPU's `expected`: hit / miss identical on at least
+/// 99.99 % of the rays, distances within 1e-3 m, the same triangle except where the two are tied.
+/// Returns (hits, ties, disagreements).
+#[cfg(feature = "gpu")]
+fn assert_agrees(
+    mesh: &SceneMesh,
+    rays: &[Ray],
+    expected: &[Option<Hit>],
+    got: &[Option<Hit>],
+) -> (usize, usize, usize) {
     let (mut disagree, mut hits, mut ties) = (0usize, 0usize, 0usize);
-    for (i, (x, y)) in expected.iter().zip(&got).enumerate() {
+    for (i, (x, y)) in expected.iter().zip(got).enumerate() {
         match (x, y) {
             (Some(x), Some(y)) => {
                 hits += 1;
@@ -368,14 +377,92 @@ fn gpu_matches_bvh() {
         }
     }
     let n = rays.len();
-    eprintln!(
-        "{n} rays: {hits} hits, {ties} ties, {disagree} hit/miss disagreements, {} CPU fallbacks",
-        gpu.cpu_fallbacks()
-    );
+    assert_eq!(got.len(), n);
     assert!(hits > n / 3, "{hits} hits of {n}");
     assert!(disagree as f64 <= 1e-4 * n as f64, "{disagree} of {n} rays disagree on hit / miss");
+    (hits, ties, disagree)
+}
+
+/// The wgpu backend against the production BVH on the random scene and on a spinning sensor's
+/// rays (skipped without an adapter, see [`gpu_caster`]).
+#[cfg(feature = "gpu")]
+#[test]
+fn gpu_matches_bvh() {
+    use sim::cast::gpu::GpuOptions;
+    let mesh = random_scene(7);
+    let Some(gpu) = gpu_caster(&mesh, GpuOptions::default()) else { return };
+    eprintln!("adapter: {}", gpu.adapter());
+    let rays = gpu_test_rays();
+    let expected = BvhCaster::new(&mesh).cast_all(&rays);
+    let got = gpu.cast_all(&rays);
+    let (hits, ties, disagree) = assert_agrees(&mesh, &rays, &expected, &got);
+    let stats = gpu.stats();
+    eprintln!(
+        "{} rays: {hits} hits, {ties} ties, {disagree} hit/miss disagreements, {} CPU fallbacks, {stats:?}",
+        rays.len(),
+        gpu.cpu_fallbacks()
+    );
+    assert_eq!(
+        (stats.rays, stats.upload_bytes, stats.readback_bytes),
+        (rays.len() as u64, 32 * rays.len() as u64, 8 * rays.len() as u64)
+    );
+    // Buffers are kept: a second call gives the same hits.
+    assert_eq!(gpu.cast_all(&rays), got);
     // Single rays and an empty scene.
     assert_eq!(gpu.cast(&rays[0]).map(|h| h.triangle), expected[0].map(|h| h.triangle));
-    let empty = GpuCaster::new(&SceneMesh::new()).unwrap();
+    let empty = gpu_caster(&SceneMesh::new(), GpuOptions::default()).expect("an adapter");
     assert_eq!(empty.cast_all(&rays[..10]), vec![None; 10]);
+}
+
+/// A device with a small storage-binding limit: the scene split over 2 node and 2 to 4 triangle
+/// bindings and the rays over many batches, two in flight, give the same hits as one binding.
+#[cfg(feature = "gpu")]
+#[test]
+fn gpu_splits_scene_and_rays_over_bindings() {
+    use sim::cast::gpu::GpuOptions;
+    let mesh = random_scene(7);
+    let Some(whole) = gpu_caster(&mesh, GpuOptions::default()) else { return };
+    let (node_bytes, tri_bytes) = whole.scene_bytes();
+    // Bindings of a power of two of nodes that holds half of them or more: exactly 2 node bindings.
+    let limit = (node_bytes / 2).next_power_of_two().max(tri_bytes.div_ceil(4).next_power_of_two() * 3 / 2);
+    let split = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit) }).expect("an adapter");
+    let (nodes, tris) = split.bindings_used();
+    eprintln!("limit {limit} B: scene {node_bytes} + {tri_bytes} B in {nodes} node and {tris} triangle bindings");
+    assert!(nodes == 2 && (2..=4).contains(&tris), "{nodes} node and {tris} triangle bindings");
+    let rays = gpu_test_rays();
+    let got = split.cast_all(&rays);
+    let batches = split.stats().batches;
+    assert!(batches >= (rays.len() as u64 * 32).div_ceil(limit), "{batches} batches");
+    assert_eq!(got, whole.cast_all(&rays));
+    let expected = BvhCaster::new(&mesh).cast_all(&rays);
+    assert_agrees(&mesh, &rays, &expected, &got);
+    // A scene that needs more bindings than the shader has is refused with the sizes.
+    let err = sim::cast::gpu::GpuCaster::with_options(&mesh, GpuOptions { max_binding_bytes: Some(256) })
+        .err()
+        .expect("too large");
+    assert!(err.to_string().contains("bytes"), "{err}");
+}
+
+/// Rays cast under a resident key are uploaded once: later calls with the key copy them on the
+/// device and give the same hits; another key uploads again.
+#[cfg(feature = "gpu")]
+#[test]
+fn gpu_keeps_resident_rays_on_the_device() {
+    use sim::cast::gpu::GpuOptions;
+    let mesh = random_scene(7);
+    let Some(gpu) = gpu_caster(&mesh, GpuOptions::default()) else { return };
+    let rays = gpu_test_rays();
+    let plain = gpu.cast_all(&rays);
+    let up0 = gpu.stats().upload_bytes;
+    let key = sim::cast::new_ray_set_key();
+    for _ in 0..3 {
+        assert_eq!(gpu.cast_all_resident(key, &rays), plain);
+    }
+    let s = gpu.stats();
+    assert_eq!((s.resident_uploads, s.upload_bytes - up0), (1, 32 * rays.len() as u64));
+    assert_eq!(gpu.cast_all_resident(sim::cast::new_ray_set_key(), &rays[..1000]), plain[..1000].to_vec());
+    assert_eq!(gpu.stats().resident_uploads, 2);
+    // CPU backends ignore the key.
+    let cpu = BvhCaster::new(&mesh);
+    assert_eq!(cpu.cast_all_resident(key, &rays[..1000]), cpu.cast_all(&rays[..1000]));
 }

@@ -100,6 +100,62 @@ pub trait Caster: Send + Sync {
         out.par_chunks_mut(CHUNK).zip(rays.par_chunks(CHUNK)).for_each(|(o, r)| self.cast_batch(r, o));
         out
     }
+
+    /// [`Caster::cast_all`] for a ray set the caller casts again unchanged under the same `key`
+    /// (a standing rig's rays, every frame): a device backend keeps it on the device and uploads it
+    /// once. Keys come from [`new_ray_set_key`]; the caller must not reuse a key for other rays.
+    fn cast_all_resident(&self, key: u64, rays: &[Ray]) -> Vec<Option<Hit>> {
+        let _ = key;
+        self.cast_all(rays)
+    }
+
+    /// Whether the backend wants a whole frame's rays per call ([`Caster::cast_all`]) rather than
+    /// a row per call from many threads ([`Caster::cast_batch`]): true for the GPU, where each call
+    /// is a round trip to the device.
+    fn prefers_frames(&self) -> bool {
+        false
+    }
+
+    /// Device counters and times for backends that run on a device, else `None`.
+    fn device_stats(&self) -> Option<DeviceStats> {
+        None
+    }
+}
+
+/// A key for [`Caster::cast_all_resident`], unique in this process.
+pub fn new_ray_set_key() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+/// What a device backend did so far: batches, rays and bytes moved, and where the time went.
+/// Device times come from timestamp queries and are `None` where the adapter has none (or, for the
+/// copies, takes timestamps only around compute passes).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DeviceStats {
+    /// Batches dispatched.
+    pub batches: u64,
+    /// Rays cast on the device.
+    pub rays: u64,
+    /// Rays cast again on the CPU (stack overflow or a failed readback).
+    pub cpu_fallbacks: u64,
+    /// Bytes of rays uploaded (resident ray sets once).
+    pub upload_bytes: u64,
+    /// Bytes of results read back.
+    pub readback_bytes: u64,
+    /// Ray sets made resident on the device.
+    pub resident_uploads: u64,
+    /// Host time inside the device backend's casting calls, seconds.
+    pub wall_s: f64,
+    /// Host time blocked waiting for the device, seconds.
+    pub wait_s: f64,
+    /// Device time in the casting kernel, seconds.
+    pub kernel_s: Option<f64>,
+    /// Device time copying rays into the kernel's buffer, seconds.
+    pub upload_s: Option<f64>,
+    /// Device time copying results to the host-visible buffer, seconds.
+    pub readback_s: Option<f64>,
 }
 
 /// Rays per parallel work item in [`Caster::cast_all`].

@@ -5,8 +5,10 @@
 //
 // nodes: 2 vec4 per node: (min.xyz, prim_count bits), (max.xyz, first_index bits); an inner node
 //        (prim_count 0) has its children at first_index and first_index + 1, a leaf its triangles
-//        at first_index .. first_index + prim_count.
-// tris:  3 vec4 per triangle (corners, w unused), in leaf order.
+//        at first_index .. first_index + prim_count. Node n lives in binding nodes{n >> NODE_SHIFT}
+//        at (n & node mask), so a BVH larger than one storage binding spans two.
+// tris:  3 vec4 per triangle (corners, w unused), in leaf order; triangle p in tris{p >> TRI_SHIFT}
+//        at (p & tri mask), up to four bindings.
 // rays:  2 vec4 per ray: (origin.xyz, t_max), (dir.xyz, 0).
 // hits:  per ray (t bits, leaf-order triangle), triangle 0xFFFFFFFF: miss, 0xFFFFFFFE: the stack
 //        overflowed (the host casts that ray on the CPU).
@@ -18,11 +20,48 @@ struct Params {
     _pad1: u32,
 };
 
-@group(0) @binding(0) var<storage, read> nodes: array<vec4<f32>>;
-@group(0) @binding(1) var<storage, read> tris: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> rays: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read_write> hits: array<vec2<u32>>;
-@group(0) @binding(4) var<uniform> params: Params;
+@group(0) @binding(0) var<storage, read> nodes0: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> nodes1: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> tris0: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> tris1: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> tris2: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> tris3: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> rays: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read_write> hits: array<vec2<u32>>;
+@group(0) @binding(8) var<uniform> params: Params;
+
+// Nodes and triangles per binding as powers of two (pipeline constants set per scene: the
+// branches below fold away when the scene fits one binding).
+override NODE_SHIFT: u32 = 31u;
+override TRI_SHIFT: u32 = 31u;
+
+// Half `h` (0: min and prim_count, 1: max and first_index) of node `n`.
+fn node(n: u32, h: u32) -> vec4<f32> {
+    let j = 2u * (n & ((1u << NODE_SHIFT) - 1u)) + h;
+    if ((n >> NODE_SHIFT) == 0u) {
+        return nodes0[j];
+    }
+    return nodes1[j];
+}
+
+// Corner `k` of leaf-order triangle `p`.
+fn corner(p: u32, k: u32) -> vec3<f32> {
+    let j = 3u * (p & ((1u << TRI_SHIFT) - 1u)) + k;
+    switch (p >> TRI_SHIFT) {
+        case 0u: {
+            return tris0[j].xyz;
+        }
+        case 1u: {
+            return tris1[j].xyz;
+        }
+        case 2u: {
+            return tris2[j].xyz;
+        }
+        default: {
+            return tris3[j].xyz;
+        }
+    }
+}
 
 const STACK: u32 = 64u;
 const MISS: u32 = 0xFFFFFFFFu;
@@ -91,8 +130,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         sp = sp - 1u;
         let n = stack[sp];
-        let lo = nodes[2u * n];
-        let hi = nodes[2u * n + 1u];
+        let lo = node(n, 0u);
+        let hi = node(n, 1u);
         // A box entered beyond a hit found since it was pushed is skipped.
         if (enter(lo.xyz, hi.xyz, o, inv, t_best) < 0.0) {
             continue;
@@ -107,8 +146,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             // The children the ray enters, the nearer on top of the stack.
             let c0 = first;
             let c1 = first + 1u;
-            let e0 = enter(nodes[2u * c0].xyz, nodes[2u * c0 + 1u].xyz, o, inv, t_best);
-            let e1 = enter(nodes[2u * c1].xyz, nodes[2u * c1 + 1u].xyz, o, inv, t_best);
+            let e0 = enter(node(c0, 0u).xyz, node(c0, 1u).xyz, o, inv, t_best);
+            let e1 = enter(node(c1, 0u).xyz, node(c1, 1u).xyz, o, inv, t_best);
             if (e0 >= 0.0 && e1 >= 0.0) {
                 if (e0 <= e1) {
                     stack[sp] = c1;
@@ -129,9 +168,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         for (var k = 0u; k < count; k = k + 1u) {
             let p = first + k;
-            let va = tris[3u * p].xyz - o;
-            let vb = tris[3u * p + 1u].xyz - o;
-            let vc = tris[3u * p + 2u].xyz - o;
+            let va = corner(p, 0u) - o;
+            let vb = corner(p, 1u) - o;
+            let vc = corner(p, 2u) - o;
             let az = axis(va, kz);
             let bz = axis(vb, kz);
             let cz = axis(vc, kz);

@@ -1,14 +1,32 @@
 //! Adapter and device: chosen through wgpu's environment conventions, with the adapter's own
-//! storage-buffer limits (a scene's BVH can exceed the 128 MiB default binding).
+//! storage-buffer limits (a scene's BVH can exceed the 128 MiB default binding) and its timestamp
+//! queries where it has them.
 
 use super::GpuError;
 
-/// A device, its queue and the compiled ray-casting pipeline.
+/// Which timestamps the device can take (none, around compute passes only, or anywhere in a
+/// command encoder, which also times the copies).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Timestamps {
+    /// No timestamp queries: kernel and transfer times are unknown.
+    None,
+    /// At the start and end of compute passes: the kernel's time.
+    Pass,
+    /// Anywhere in an encoder: the upload copy, the kernel and the readback copy.
+    Encoder,
+}
+
+/// A device, its queue and the compiled ray-casting shader.
 pub(super) struct Gpu {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
-    pub(super) pipeline: wgpu::ComputePipeline,
+    pub(super) shader: wgpu::ShaderModule,
+    pub(super) pipeline_layout: wgpu::PipelineLayout,
     pub(super) layout: wgpu::BindGroupLayout,
+    /// The timestamps this device takes.
+    pub(super) timestamps: Timestamps,
+    /// Nanoseconds per timestamp tick.
+    pub(super) timestamp_period_ns: f64,
     /// Largest storage binding, bytes.
     pub(super) max_binding_bytes: u64,
     /// Adapter name, backend and type.
@@ -46,15 +64,32 @@ fn describe(info: &wgpu::AdapterInfo) -> String {
 }
 
 impl Gpu {
-    /// Opens the device and compiles `cast.wgsl`.
+    /// Opens the device (with timestamp queries where the adapter has them) and compiles
+    /// `cast.wgsl`; the pipeline is made per scene ([`super::scene::SceneBuffers`]), whose split
+    /// into bindings sets its constants.
     pub(super) fn new() -> Result<Self, GpuError> {
         let adapter = adapter()?;
         let info = adapter.get_info();
         let description = describe(&info);
         let limits = adapter.limits();
+        let has = adapter.features();
+        let timestamps =
+            if has.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
+                Timestamps::Encoder
+            } else if has.contains(wgpu::Features::TIMESTAMP_QUERY) {
+                Timestamps::Pass
+            } else {
+                Timestamps::None
+            };
+        let required_features = match timestamps {
+            Timestamps::Encoder => wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+            Timestamps::Pass => wgpu::Features::TIMESTAMP_QUERY,
+            Timestamps::None => wgpu::Features::empty(),
+        };
         let desc = wgpu::DeviceDescriptor {
             label: Some("groundtruth caster"),
             required_limits: limits.clone(),
+            required_features,
             ..Default::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
@@ -79,9 +114,13 @@ impl Gpu {
                 storage(0, true),
                 storage(1, true),
                 storage(2, true),
-                storage(3, false),
+                storage(3, true),
+                storage(4, true),
+                storage(5, true),
+                storage(6, true),
+                storage(7, false),
                 wgpu::BindGroupLayoutEntry {
-                    binding: 4,
+                    binding: 8,
                     visibility: wgpu::ShaderStages::COMPUTE,
                     ty: wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Uniform,
@@ -97,15 +136,18 @@ impl Gpu {
             bind_group_layouts: &[Some(&layout)],
             ..Default::default()
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("cast"),
-            layout: Some(&pipeline_layout),
-            module: &shader,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
         let max_binding_bytes = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-        Ok(Self { device, queue, pipeline, layout, max_binding_bytes, description })
+        let timestamp_period_ns = f64::from(queue.get_timestamp_period());
+        Ok(Self {
+            device,
+            queue,
+            shader,
+            pipeline_layout,
+            layout,
+            timestamps,
+            timestamp_period_ns,
+            max_binding_bytes,
+            description,
+        })
     }
 }

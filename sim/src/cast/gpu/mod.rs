@@ -10,22 +10,28 @@
 //!   forced, so a real GPU is used where there is one.
 //! - Hits carry the distance and the triangle, as the CPU backends' do, so labels, normals and
 //!   measurement effects stay shared code.
-//! - Rays go to the device in batches that respect the device's storage-binding size limit; the
-//!   batch buffers are reused across the batches of a call.
-//! - Limits of this first version: no f64 fallback in the triangle test (a ray exactly through a
-//!   shared edge may report the other triangle, as ties may on the CPU), rays whose traversal
-//!   overflows the stack are cast again on the CPU (counted by [`GpuCaster::cpu_fallbacks`]),
-//!   readback is synchronous and the rays are uploaded for every call rather than generated on
-//!   the GPU.
+//! - A scene larger than one storage binding is split over up to 2 node and 4 triangle bindings
+//!   ([`scene`]); rays go through in batches within the binding and dispatch limits, two batch
+//!   slots kept across calls, the next batch uploaded and run while the previous one is read back
+//!   ([`stream`]). The scanner hands over a whole frame per call ([`Caster::prefers_frames`]), and a
+//!   standing rig's rays once ([`Caster::cast_all_resident`]): they stay on the device.
+//! - Where the adapter has timestamp queries, [`GpuCaster::stats`] splits the device's time into
+//!   the upload copy, the kernel and the readback copy.
+//! - Limits: no f64 fallback in the triangle test (a ray exactly through a shared edge may report
+//!   the other triangle, as ties may on the CPU); rays whose traversal overflows the stack are cast
+//!   again on the CPU (counted); a moving rig's rays are made on the CPU and uploaded every frame,
+//!   because rays transformed on the device (its `sqrt` and division are not correctly rounded)
+//!   would not be the same bits as the CPU backends' and scans would no longer match them.
 
 mod device;
-mod layout;
+mod scene;
+mod stream;
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 use thiserror::Error;
 
-use super::{BvhCaster, Caster, Hit, Ray};
+use super::{BvhCaster, Caster, DeviceStats, Hit, Ray};
 use crate::scene::SceneMesh;
 
 pub use device::adapter_description;
@@ -58,22 +64,42 @@ pub enum GpuError {
     },
 }
 
+/// Options of [`GpuCaster::with_options`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuOptions {
+    /// Largest storage binding to use, bytes (`None`: the device's limit). A smaller value splits
+    /// the scene over more bindings and the rays into smaller batches, as a device with that
+    /// limit would (tests use it to exercise the splits on a small scene).
+    pub max_binding_bytes: Option<u64>,
+}
+
 /// Ray casting on a GPU through wgpu (module docs).
 pub struct GpuCaster {
     gpu: device::Gpu,
-    scene: layout::SceneBuffers,
-    /// CPU caster for the rays whose traversal overflows the stack, and for single rays.
+    scene: scene::SceneBuffers,
+    /// CPU caster for the rays whose traversal overflows the stack.
     cpu: BvhCaster,
-    fallbacks: AtomicU64,
+    /// Batch slots, upload belt, resident rays and counters; one caller at a time.
+    stream: Mutex<stream::Stream>,
+    max_binding_bytes: u64,
 }
 
 impl GpuCaster {
     /// Builds the BVH of `mesh`, uploads it and compiles the shader on the adapter wgpu's
     /// environment variables choose (module docs).
     pub fn new(mesh: &SceneMesh) -> Result<Self, GpuError> {
-        let gpu = device::Gpu::new()?;
-        let scene = layout::SceneBuffers::new(&gpu, mesh)?;
-        Ok(Self { gpu, scene, cpu: BvhCaster::new(mesh), fallbacks: AtomicU64::new(0) })
+        Self::with_options(mesh, GpuOptions::default())
+    }
+
+    /// [`GpuCaster::new`] with `options`.
+    pub fn with_options(mesh: &SceneMesh, options: GpuOptions) -> Result<Self, GpuError> {
+        let mut gpu = device::Gpu::new()?;
+        let max_binding_bytes =
+            options.max_binding_bytes.map_or(gpu.max_binding_bytes, |b| b.clamp(256, gpu.max_binding_bytes));
+        gpu.max_binding_bytes = max_binding_bytes;
+        let scene = scene::SceneBuffers::new(&gpu, mesh, max_binding_bytes)?;
+        let stream = Mutex::new(stream::Stream::new(&gpu));
+        Ok(Self { gpu, scene, cpu: BvhCaster::new(mesh), stream, max_binding_bytes })
     }
 
     /// The adapter in use: name, backend and device type.
@@ -81,20 +107,49 @@ impl GpuCaster {
         &self.gpu.description
     }
 
+    /// The largest storage binding in use, bytes.
+    pub fn max_binding_bytes(&self) -> u64 {
+        self.max_binding_bytes
+    }
+
+    /// How many node and triangle bindings the scene occupies (more than one when it exceeds
+    /// [`GpuCaster::max_binding_bytes`]).
+    pub fn bindings_used(&self) -> (usize, usize) {
+        self.scene.bindings_used
+    }
+
+    /// Bytes of the scene's BVH nodes and of its triangles on the device.
+    pub fn scene_bytes(&self) -> (u64, u64) {
+        self.scene.bytes
+    }
+
     /// How many rays so far were cast again on the CPU because their traversal overflowed the
     /// shader's stack.
     pub fn cpu_fallbacks(&self) -> u64 {
-        self.fallbacks.load(Ordering::Relaxed)
+        self.stats().cpu_fallbacks
     }
 
-    /// Casts `rays` on the GPU; `out[i]` receives the closest hit of `rays[i]`.
-    fn cast_gpu(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        let raw = self.scene.cast(&self.gpu, rays);
+    /// Counters and times of everything cast so far.
+    pub fn stats(&self) -> DeviceStats {
+        self.lock().stats
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, stream::Stream> {
+        // A panic while the lock was held leaves the counters, at worst, short of one batch.
+        self.stream.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// Casts `rays` on the GPU (kept on the device under `resident`); `out[i]` receives the
+    /// closest hit of `rays[i]`.
+    fn cast_gpu(&self, rays: &[Ray], resident: Option<u64>, out: &mut [Option<Hit>]) {
+        let mut raw = Vec::with_capacity(rays.len());
+        let mut stream = self.lock();
+        stream.cast(&self.gpu, &self.scene, rays, resident, &mut raw);
         for ((o, ray), (t_bits, prim)) in out.iter_mut().zip(rays).zip(raw) {
             *o = match prim {
-                layout::MISS => None,
-                layout::OVERFLOW => {
-                    self.fallbacks.fetch_add(1, Ordering::Relaxed);
+                stream::MISS => None,
+                stream::OVERFLOW => {
+                    stream.stats.cpu_fallbacks += 1;
                     self.cpu.cast(ray)
                 }
                 p => Some(Hit { t: f32::from_bits(t_bits), triangle: self.scene.order_to_triangle[p as usize] }),
@@ -106,18 +161,32 @@ impl GpuCaster {
 impl Caster for GpuCaster {
     fn cast(&self, ray: &Ray) -> Option<Hit> {
         let mut out = [None];
-        self.cast_gpu(std::slice::from_ref(ray), &mut out);
+        self.cast_gpu(std::slice::from_ref(ray), None, &mut out);
         out[0]
     }
 
     fn cast_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        self.cast_gpu(rays, out);
+        self.cast_gpu(rays, None, out);
     }
 
-    /// All rays in one submission per batch (no rayon: the device runs them in parallel).
+    /// All rays in one stream of batches (no rayon: the device runs them in parallel).
     fn cast_all(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
         let mut out = vec![None; rays.len()];
-        self.cast_gpu(rays, &mut out);
+        self.cast_gpu(rays, None, &mut out);
         out
+    }
+
+    fn cast_all_resident(&self, key: u64, rays: &[Ray]) -> Vec<Option<Hit>> {
+        let mut out = vec![None; rays.len()];
+        self.cast_gpu(rays, Some(key), &mut out);
+        out
+    }
+
+    fn prefers_frames(&self) -> bool {
+        true
+    }
+
+    fn device_stats(&self) -> Option<DeviceStats> {
+        Some(self.stats())
     }
 }
