@@ -139,8 +139,10 @@ impl BeamTable {
         let horizontal_m = pick(&self.horizontal_offsets_m);
         let vertical_m = pick(&self.vertical_offsets_m);
         let mean_vertical_m = vertical_m.iter().sum::<f32>() / n as f32;
+        let tan_elevation: Vec<f32> = elevation_rad.iter().map(|e| e.tan()).collect();
         Ok(TableRows {
-            tan_elevation: elevation_rad.iter().map(|e| e.tan()).collect(),
+            guess: RowGuess::new(&tan_elevation),
+            tan_elevation,
             elevation_rad,
             horizontal_m,
             vertical_m,
@@ -174,6 +176,55 @@ pub struct TableRows {
     pub azimuth_step_rad: f32,
     /// Whether the columns wrap over a full turn.
     pub full_turn: bool,
+    /// First guess of a point's row from its `tan(elevation)`.
+    guess: RowGuess,
+}
+
+/// Rows below `tan(elevation)` by a lookup in uniform bins, then a step or two: the same as a
+/// binary search over the rows, without its chain of dependent, unpredictable branches.
+#[derive(Clone, Debug, PartialEq)]
+struct RowGuess {
+    /// `tan(elevation)` of the first bin's lower edge.
+    lo: f32,
+    /// Bins per unit of `tan(elevation)`.
+    scale: f32,
+    /// Per bin: how many rows lie below its lower edge.
+    below: Vec<u16>,
+}
+
+impl RowGuess {
+    /// Bins: 8 per smallest gap between rows over the table's span, at most 4,096.
+    fn new(tan: &[f32]) -> Self {
+        let (first, last) = (tan[0], tan[tan.len() - 1]);
+        let span = (last - first).max(1e-6);
+        let bins = 4096usize.min(tan.len() * 64);
+        let scale = bins as f32 / span;
+        let below = (0..=bins)
+            .map(|b| {
+                let edge = first + b as f32 / scale;
+                tan.partition_point(|&x| x < edge) as u16
+            })
+            .collect();
+        Self { lo: first, scale, below }
+    }
+
+    /// `tan.partition_point(|&x| x < t)` for the table's `tan` (increasing).
+    // `!(a < t)` as the binary search compares: NaN counts no row below.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    #[inline(always)]
+    fn rows_below(&self, tan: &[f32], t: f32) -> usize {
+        // NaN and values below the first edge go to bin 0, values above to the last (casts saturate).
+        let bin = (((t - self.lo) * self.scale) as usize).min(self.below.len() - 1);
+        let mut g = usize::from(self.below[bin]);
+        // The bin's edge is rounded: step down, then up, to the exact count.
+        while g > 0 && !(tan[g - 1] < t) {
+            g -= 1;
+        }
+        while g < tan.len() && tan[g] < t {
+            g += 1;
+        }
+        g
+    }
 }
 
 impl TableRows {
@@ -202,7 +253,7 @@ impl TableRows {
         let tan = &self.tan_elevation;
         let inv_d = 1.0 / d2.sqrt().max(1e-6);
         let t0 = (p.z - self.mean_vertical_m) * inv_d;
-        let guess = tan.partition_point(|&x| x < t0).min(n - 1);
+        let guess = self.guess.rows_below(tan, t0).min(n - 1);
         // 1 / sqrt(d^2 - h^2) = (1 / d) (1 + h^2 / (2 d^2)) to well within 1e-6 for h << d.
         let inv_d2 = inv_d * inv_d;
         let fine = |r: usize| {
@@ -211,17 +262,50 @@ impl TableRows {
         };
         let (lo, hi) = (guess.saturating_sub(2), (guess + 2).min(n - 1));
         let mut best = (f32::INFINITY, guess, t0);
-        for (r, &tan_r) in tan.iter().enumerate().take(hi + 1).skip(lo) {
+        // Always five candidates, the last repeated near the top (a repeat never wins a strict
+        // comparison): a fixed loop of selects rather than branches.
+        for k in 0..5 {
+            let r = (lo + k).min(hi);
             let f = fine(r);
-            let e = (f - tan_r).abs();
-            if e < best.0 {
-                best = (e, r, f);
-            }
+            let e = (f - tan[r]).abs();
+            best = if e < best.0 { (e, r, f) } else { best };
         }
         let (_, r, f) = best;
         let outside = (r == 0 && tan[0] - f > 0.5 * (tan[1] - tan[0]))
             || (r == n - 1 && f - tan[n - 1] > 0.5 * (tan[n - 1] - tan[n - 2]));
         (r, f, outside)
+    }
+
+    /// [`TableRows::nearest_row`]'s `tan(elevation)` (the second value) of the points
+    /// `points[valid[i]]` into `out[i]`, the same bits; `dist[i]` is the point's horizontal
+    /// distance `sqrt(x * x + y * y)`. Two passes: the divisions vectorized, then the row search.
+    pub(crate) fn fine_tans(&self, points: &[glam::Vec3], valid: &[u32], dist: &[f32], out: &mut [f32]) {
+        let (n, tan, mean_v) = (self.len(), &self.tan_elevation[..], self.mean_vertical_m);
+        let (h, v) = (&self.horizontal_m[..n], &self.vertical_m[..n]);
+        for (o, &k) in out.iter_mut().zip(valid) {
+            *o = points[k as usize].z;
+        }
+        // Pass 1: `1 / d` per point into `inv`, `t0` into `out` (vectorizes).
+        let mut inv = vec![0f32; out.len()];
+        for ((o, i), &d) in out.iter_mut().zip(inv.iter_mut()).zip(dist) {
+            *i = 1.0 / d.max(1e-6);
+            *o = (*o - mean_v) * *i;
+        }
+        // Pass 2: the nearest row's fine value.
+        for ((o, &inv_d), &k) in out.iter_mut().zip(&inv).zip(valid) {
+            let (z, t0) = (points[k as usize].z, *o);
+            let guess = self.guess.rows_below(tan, t0).min(n - 1);
+            let inv_d2 = inv_d * inv_d;
+            let (lo, hi) = (guess.saturating_sub(2), (guess + 2).min(n - 1));
+            let (mut best_e, mut best_f) = (f32::INFINITY, t0);
+            for j in 0..5 {
+                let r = (lo + j).min(hi);
+                let f = (z - v[r]) * inv_d * (1.0 + 0.5 * h[r] * h[r] * inv_d2);
+                let e = (f - tan[r]).abs();
+                (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
+            }
+            *o = best_f;
+        }
     }
 
     /// Azimuth of the beam of row `row` that hit `p` (sensor frame): the point's azimuth less the
@@ -295,4 +379,54 @@ pub fn round_fast(x: f32) -> f32 {
     let y = x + 0.5;
     let t = y as i64 as f32;
     if t > y { t - 1.0 } else { t }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The binned guess counts the rows below exactly as a binary search does, at bin edges, at the
+    /// rows' own values, outside the table and for NaN.
+    #[test]
+    fn rows_below_equals_the_binary_search() {
+        let os1 =
+            BeamTable::spinning((0..128).map(|i| (-22.5f32 + 45.0 * i as f32 / 127.0).to_radians()).collect(), 1024);
+        for table in [BeamTable::hdl64e(2170), os1] {
+            let rows = table.rows().unwrap();
+            let tan = &rows.tan_elevation;
+            let mut probes: Vec<f32> = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -10.0, 10.0];
+            for &t in tan {
+                probes.extend([t, f32::from_bits(t.to_bits() + 1), f32::from_bits(t.to_bits() - 1)]);
+            }
+            let (lo, hi) = (tan[0] - 0.1, tan[tan.len() - 1] + 0.1);
+            probes.extend((0..100_000).map(|i| lo + (hi - lo) * i as f32 / 100_000.0));
+            for t in probes {
+                assert_eq!(rows.guess.rows_below(tan, t), tan.partition_point(|&x| x < t), "t {t}");
+            }
+        }
+    }
+
+    /// The batch of fine elevations is bit for bit [`TableRows::nearest_row`]'s, with origin offsets.
+    #[test]
+    fn fine_tans_equal_nearest_row() {
+        let mut table = BeamTable::hdl64e(2083);
+        let n = table.elevations_rad.len();
+        table.horizontal_offsets_m = (0..n).map(|i| 0.02 * ((i % 7) as f32 - 3.0)).collect();
+        table.vertical_offsets_m = (0..n).map(|i| 0.2 + 0.003 * (i % 11) as f32).collect();
+        let rows = table.rows().unwrap();
+        let points: Vec<glam::Vec3> = (0..20_000)
+            .map(|i| {
+                let (a, r) = (i as f32 * 0.37, 0.5 + (i % 997) as f32 * 0.08);
+                glam::Vec3::new(r * a.cos(), r * a.sin(), -2.0 + (i % 389) as f32 * 0.01)
+            })
+            .collect();
+        let valid: Vec<u32> = (0..points.len() as u32).filter(|k| k % 5 != 3).collect();
+        let dist: Vec<f32> =
+            valid.iter().map(|&k| (points[k as usize].x.powi(2) + points[k as usize].y.powi(2)).sqrt()).collect();
+        let mut got = vec![0.0; valid.len()];
+        rows.fine_tans(&points, &valid, &dist, &mut got);
+        for (g, &k) in got.iter().zip(&valid) {
+            assert_eq!(g.to_bits(), rows.nearest_row(points[k as usize]).1.to_bits(), "point {k}");
+        }
+    }
 }

@@ -280,9 +280,7 @@ pub(crate) fn unfold_wishes(
     if rows.horizontal_m.iter().chain(&rows.vertical_m).any(|&x| x != 0.0) {
         // With origin offsets, the elevation seen from the nearest beam's origin; without them the
         // elevation seen from the sensor origin is exact enough.
-        for (f, &k) in fine.iter_mut().zip(valid) {
-            *f = rows.nearest_row(points[k as usize]).1;
-        }
+        rows.fine_tans(points, valid, &dist, &mut fine);
     }
     let (starts, dir) = ring_starts(&az, &dist, &fine, rows, params)?;
     let mut bounds = starts.clone();
