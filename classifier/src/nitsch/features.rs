@@ -299,6 +299,16 @@ impl Outputs<'_> {
         self.g_rho[i0..i0 + m].copy_from_slice(&og[..m]);
     }
 
+    /// Writes cell `i` from lane `l` of `f`: its features where `ok`, zeros elsewhere (the values
+    /// [`Outputs::write`] gives a lane).
+    #[inline(always)]
+    fn write_one(&mut self, i: usize, ok: bool, f: &Cells, l: usize) {
+        let (n, rho) = if ok { (Vec3::new(f.n[0][l], f.n[1][l], f.n[2][l]), f.rho[l]) } else { (Vec3::ZERO, 0.0) };
+        self.normal[i] = n;
+        self.n_rho[i] = rho;
+        self.g_rho[i] = n.z * rho;
+    }
+
     /// Zeros for the `m` cells from `i0` on.
     #[inline(always)]
     fn zero(&mut self, i0: usize, m: usize) {
@@ -371,6 +381,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     if inner < 2 {
         return;
     }
+    let mut queue = GeneralQueue::new();
     soa.horizontal.resize(cols, 0.0);
     soa.edge.resize(rows - 1, [0.0; squares::SQUARE_FIELDS]);
     for sq in &mut soa.squares {
@@ -387,14 +398,58 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
             let (below, above) = (&ring[(r - 1) % 2], &ring[r % 2]);
             for j in tile.start.max(1)..tile.end {
                 let (b, a) = (&below[j - tile.start], &above[j - tile.start]);
-                fast_block(&plane, b, a, horizontal, r, j, &mut lanes, &mut outputs);
+                fast_block(&plane, b, a, horizontal, r, j, &mut queue, &mut outputs);
             }
         }
+    }
+    queue.flush(&plane, &mut outputs);
+}
+
+/// Cells of the fast path that lack a direct neighbour, gathered from many blocks so that their
+/// features ([`lane_features`]) run `L` at a time instead of once per block for a few lanes (real
+/// recordings leave empty cells scattered over every ring: half the blocks have one).
+struct GeneralQueue {
+    lanes: Lanes,
+    /// Cell index and whether it has a return, per queued lane.
+    cells: [(usize, bool); L],
+    len: usize,
+}
+
+impl GeneralQueue {
+    fn new() -> Self {
+        let lanes =
+            Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
+        Self { lanes, cells: [(0, false); L], len: 0 }
+    }
+
+    /// Queues cell `(r, c)`; computes and writes the queue when it is full.
+    #[inline(always)]
+    fn push(&mut self, plane: &Plane<'_>, r: usize, c: usize, out: &mut Outputs<'_>) {
+        let ok = fill_one(plane, r, c, self.len, &mut self.lanes);
+        self.cells[self.len] = (r * plane.view.cols + c, ok);
+        self.len += 1;
+        if self.len == L {
+            self.flush(plane, out);
+        }
+    }
+
+    /// Computes the queued cells' features and writes them (stale lanes past `len` are ignored).
+    #[inline(always)]
+    fn flush(&mut self, plane: &Plane<'_>, out: &mut Outputs<'_>) {
+        if self.len == 0 {
+            return;
+        }
+        let mut g = Cells::default();
+        lane_features(&self.lanes, plane.min_pairs, &mut g);
+        for (l, &(i, ok)) in self.cells[..self.len].iter().enumerate() {
+            out.write_one(i, ok, &g, l);
+        }
+        self.len = 0;
     }
 }
 
 /// The `L` cells of row `r` in chunk `j` (clear of the grid's edges) from the squares of the chunk
-/// below and above the row; cells that lack a direct neighbour again by the general search.
+/// below and above the row; cells that lack a direct neighbour go to `queue` (the general search).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn fast_block(
@@ -404,7 +459,7 @@ fn fast_block(
     horizontal: &[f32],
     r: usize,
     j: usize,
-    lanes: &mut Lanes,
+    queue: &mut GeneralQueue,
     out: &mut Outputs<'_>,
 ) {
     let cols = plane.view.cols;
@@ -423,21 +478,16 @@ fn fast_block(
     let acc = squares::dense_block(plane.view.ranges, below, above, horizontal, r, j, cols, &plane.tests);
     let mut f = Cells::default();
     acc.finish(plane.min_pairs, &mut f);
-    let mut cell_ok = [true; L];
+    out.write(i0, L, &[true; L], &f);
     if !dense {
-        // Some cells lack a direct neighbour: those again by the general search.
-        let mut general = [false; L];
+        // Some cells lack a direct neighbour: those again by the general search (their lanes above
+        // are overwritten when the queue is computed).
         for l in 0..L {
             if !(cv[l] & cv[l + 1] & cv[l + 2]) {
-                general[l] = true;
-                cell_ok[l] = fill_one(plane, r, c0 + l, l, lanes);
+                queue.push(plane, r, c0 + l, out);
             }
         }
-        let mut g = Cells::default();
-        lane_features(lanes, plane.min_pairs, &mut g);
-        f.take(&general, &g);
     }
-    out.write(i0, L, &cell_ok, &f);
 }
 
 /// Eq. 1-3 for `L` cells from their neighbour offsets into `out`: the unit normal and `n_rho`
@@ -480,18 +530,6 @@ struct Cells {
     rho: [f32; L],
 }
 
-impl Cells {
-    /// Takes the lanes where `take` is set from `other`.
-    #[inline(always)]
-    fn take(&mut self, take: &[bool; L], other: &Cells) {
-        for l in 0..L {
-            for a in 0..3 {
-                self.n[a][l] = if take[l] { other.n[a][l] } else { self.n[a][l] };
-            }
-            self.rho[l] = if take[l] { other.rho[l] } else { self.rho[l] };
-        }
-    }
-}
 
 impl Acc {
     /// Eq. 2-3 from the sums into `out`: the unit normal and `n_rho` per lane, zeros where a
