@@ -530,7 +530,6 @@ struct Cells {
     rho: [f32; L],
 }
 
-
 impl Acc {
     /// Eq. 2-3 from the sums into `out`: the unit normal and `n_rho` per lane, zeros where a
     /// cell has fewer than `min_pairs` pairs or a degenerate sum.
