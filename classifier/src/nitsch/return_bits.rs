@@ -63,21 +63,16 @@ fn first_along(w: u64, p: usize, step: isize, gap: usize) -> Option<usize> {
     }
 }
 
-/// In window `w`: the return nearest to bit `REACH` (itself, then `+1`, `-1`, `+2`, ...).
+/// In window `w`: the return nearest to bit `REACH` (itself, then `+1`, `-1`, `+2`, ...), within
+/// `gap`. Bit counts rather than a loop of tests: the distances to the nearest return at or above
+/// and at or below the bit, the `+` side on a tie.
 #[inline(always)]
 fn nearest(w: u64, gap: usize) -> Option<usize> {
-    if w >> REACH & 1 == 1 {
-        return Some(REACH);
-    }
-    (1..=gap).find_map(|k| {
-        if w >> (REACH + k) & 1 == 1 {
-            Some(REACH + k)
-        } else if w >> (REACH - k) & 1 == 1 {
-            Some(REACH - k)
-        } else {
-            None
-        }
-    })
+    // 64 where there is none on that side.
+    let up = (w >> REACH).trailing_zeros() as usize;
+    let down = (w << (63 - REACH)).leading_zeros() as usize;
+    let (d, bit) = if up <= down { (up, REACH + up) } else { (down, REACH.wrapping_sub(down)) };
+    (d <= gap).then_some(bit)
 }
 
 /// [`GridView::neighbours`] of `(r, c)` through `bits` (the view's returns).
