@@ -396,7 +396,7 @@ mod tests {
             let tan = &rows.tan_elevation;
             let mut probes: Vec<f32> = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -10.0, 10.0];
             for &t in tan {
-                probes.extend([t, f32::from_bits(t.to_bits() + 1), f32::from_bits(t.to_bits() - 1)]);
+                probes.extend([t, t.next_up(), t.next_down()]);
             }
             let (lo, hi) = (tan[0] - 0.1, tan[tan.len() - 1] + 0.1);
             probes.extend((0..100_000).map(|i| lo + (hi - lo) * i as f32 / 100_000.0));
