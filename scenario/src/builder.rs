@@ -4,78 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
-use sim::rig::Mount;
 use sim::scan::{MAX_FRAMES, ScanConfig};
 
 use crate::error::{Result, ScenarioError};
 use crate::geometry::Geometry;
+use crate::mount_override::MountOverride;
+use crate::param_value::ParamValue;
 use crate::scan::Scan;
-
-/// A parameter value for [`Scenario::param`]: a number, an integer, a flag or a word, as in the
-/// `[params]` table of a scene file.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ParamValue {
-    /// A real number (most parameters: `slope_deg`, `depth_m`, ...).
-    Float(f64),
-    /// An integer (counts, e.g. `objects` of `flat`).
-    Int(i64),
-    /// A flag.
-    Bool(bool),
-    /// A word (e.g. `sides = "railings"` of `ramp`).
-    Text(String),
-}
-
-impl From<f64> for ParamValue {
-    fn from(v: f64) -> Self {
-        Self::Float(v)
-    }
-}
-impl From<f32> for ParamValue {
-    fn from(v: f32) -> Self {
-        Self::Float(f64::from(v))
-    }
-}
-impl From<i64> for ParamValue {
-    fn from(v: i64) -> Self {
-        Self::Int(v)
-    }
-}
-impl From<i32> for ParamValue {
-    fn from(v: i32) -> Self {
-        Self::Int(i64::from(v))
-    }
-}
-impl From<u32> for ParamValue {
-    fn from(v: u32) -> Self {
-        Self::Int(i64::from(v))
-    }
-}
-impl From<bool> for ParamValue {
-    fn from(v: bool) -> Self {
-        Self::Bool(v)
-    }
-}
-impl From<&str> for ParamValue {
-    fn from(v: &str) -> Self {
-        Self::Text(v.to_string())
-    }
-}
-impl From<String> for ParamValue {
-    fn from(v: String) -> Self {
-        Self::Text(v)
-    }
-}
-
-impl ParamValue {
-    fn to_toml(&self) -> toml::Value {
-        match self {
-            Self::Float(v) => toml::Value::Float(*v),
-            Self::Int(v) => toml::Value::Integer(*v),
-            Self::Bool(v) => toml::Value::Boolean(*v),
-            Self::Text(v) => toml::Value::String(v.clone()),
-        }
-    }
-}
 
 /// Where the scene comes from.
 #[derive(Clone, Debug)]
@@ -92,57 +27,6 @@ enum RigSource {
     Preset(String),
     File(PathBuf),
     Value(sim::Rig),
-}
-
-/// Overrides of one sensor's mount; `None` keeps the rig's value.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct MountOverride {
-    /// Position x, metres (-50 ..= 50).
-    pub x_m: Option<f32>,
-    /// Position y, metres (-50 ..= 50).
-    pub y_m: Option<f32>,
-    /// Height above the ground, metres (-5 ..= 20).
-    pub z_m: Option<f32>,
-    /// Roll, degrees (-180 ..= 180).
-    pub roll_deg: Option<f32>,
-    /// Pitch, degrees, positive tilts the sensor down (-90 ..= 90).
-    pub pitch_deg: Option<f32>,
-    /// Yaw, degrees, positive turns it left (-360 ..= 360).
-    pub yaw_deg: Option<f32>,
-}
-
-impl MountOverride {
-    /// Checks every set field, naming `mount.<field>` and its range.
-    pub fn validate(&self) -> Result<()> {
-        let fields = [
-            ("mount.x_m", self.x_m, -50.0, 50.0),
-            ("mount.y_m", self.y_m, -50.0, 50.0),
-            ("mount.z_m", self.z_m, -5.0, 20.0),
-            ("mount.roll_deg", self.roll_deg, -180.0, 180.0),
-            ("mount.pitch_deg", self.pitch_deg, -90.0, 90.0),
-            ("mount.yaw_deg", self.yaw_deg, -360.0, 360.0),
-        ];
-        for (name, v, lo, hi) in fields {
-            if let Some(v) = v
-                && !(v.is_finite() && (lo..=hi).contains(&v))
-            {
-                return Err(ScenarioError::invalid(name, v, format!("{lo} ..= {hi}")));
-            }
-        }
-        Ok(())
-    }
-
-    /// `mount` with the set fields replaced.
-    pub fn apply(&self, mount: Mount) -> Mount {
-        Mount {
-            x_m: self.x_m.unwrap_or(mount.x_m),
-            y_m: self.y_m.unwrap_or(mount.y_m),
-            z_m: self.z_m.unwrap_or(mount.z_m),
-            roll_deg: self.roll_deg.unwrap_or(mount.roll_deg),
-            pitch_deg: self.pitch_deg.unwrap_or(mount.pitch_deg),
-            yaw_deg: self.yaw_deg.unwrap_or(mount.yaw_deg),
-        }
-    }
 }
 
 /// A scenario to scan: what the scene is, which rig sees it and how.

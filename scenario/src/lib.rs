@@ -31,14 +31,18 @@
 mod builder;
 pub mod error;
 mod geometry;
+mod mount_override;
+mod param_value;
 pub mod region;
 mod scan;
 pub mod score;
 #[cfg(feature = "proptest")]
 pub mod strategies;
 
-pub use builder::{MountOverride, ParamValue, Scenario};
+pub use builder::Scenario;
 pub use error::{Result, ScenarioError};
+pub use mount_override::MountOverride;
+pub use param_value::ParamValue;
 pub use region::Region;
 pub use scan::{Decisions, Scan};
 pub use score::RegionScore;

@@ -17,7 +17,7 @@ use std::ops::RangeInclusive;
 
 use proptest::prelude::*;
 
-use crate::builder::{MountOverride, Scenario};
+use crate::{MountOverride, Scenario};
 
 /// A `ramp` scene: the corridor's slope (negative descends) and the distance to its foot.
 #[derive(Clone, Copy, Debug, PartialEq)]
