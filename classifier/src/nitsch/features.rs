@@ -37,6 +37,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod general;
+mod lanes;
 mod squares;
 
 use glam::Vec3;
@@ -44,7 +45,8 @@ use glam::Vec3;
 use crate::error::{ClassifyError, Result};
 use crate::nitsch::neighbours::GridView;
 use crate::nitsch::return_bits::ReturnBits;
-use general::{fill_one, general_block};
+use general::{GeneralQueue, general_block};
+use lanes::{Acc, Cells, Lanes, lane_features, rsqrt};
 
 /// Parameters of the feature computation besides the neighbourhood.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -149,17 +151,6 @@ const L: usize = 16;
 /// Grid offsets `(row, col)` of `d1..d8` (see [`crate::nitsch::neighbours`]).
 const OFFSETS: [(isize, isize); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
 
-/// Neighbour offsets of `L` cells, lane-wise: `dx[k][l]` is `d_(k+1)` of lane `l` (0 where missing in
-/// the general path; `ok` 0 marks a dropped neighbour).
-struct Lanes {
-    dx: [[f32; L]; 8],
-    dy: [[f32; L]; 8],
-    dz: [[f32; L]; 8],
-    ok: [[f32; L]; 8],
-    /// `|d|` per lane (0 where missing in the general path; any finite value where `ok` is 0).
-    len: [[f32; L]; 8],
-}
-
 /// What the per-neighbour test needs besides the points.
 #[derive(Clone, Copy)]
 struct Tests {
@@ -184,28 +175,6 @@ impl Tests {
     #[inline(always)]
     fn keep_len(&self, k: usize, len: f32, range_j: f32, range: f32) -> bool {
         (len <= self.max_d) & (len > 0.0) & !(range_j < self.keep[k] * range)
-    }
-}
-
-/// Per-lane sums over a cell's pairs: Eq. 2's weighted normal sum, the sum of the unit pair normals
-/// (Eq. 3) and the number of pairs.
-#[derive(Default)]
-struct Acc {
-    s: [[f32; L]; 3],
-    e: [[f32; L]; 3],
-    pairs: [f32; L],
-}
-
-impl Acc {
-    /// Adds pair normal `n` with `1 / |n|` factor `iv` and Eq. 2 weight `w` (both 0 for a
-    /// missing pair) to lane `l`; `valid` is 1 for a pair that exists.
-    #[inline(always)]
-    fn add(&mut self, l: usize, n: [f32; 3], iv: f32, w: f32, valid: f32) {
-        for a in 0..3 {
-            self.e[a][l] += n[a] * iv;
-            self.s[a][l] += n[a] * w;
-        }
-        self.pairs[l] += valid;
     }
 }
 
@@ -405,49 +374,6 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     queue.flush(&plane, &mut outputs);
 }
 
-/// Cells of the fast path that lack a direct neighbour, gathered from many blocks so that their
-/// features ([`lane_features`]) run `L` at a time instead of once per block for a few lanes (real
-/// recordings leave empty cells scattered over every ring: half the blocks have one).
-struct GeneralQueue {
-    lanes: Lanes,
-    /// Cell index and whether it has a return, per queued lane.
-    cells: [(usize, bool); L],
-    len: usize,
-}
-
-impl GeneralQueue {
-    fn new() -> Self {
-        let lanes =
-            Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
-        Self { lanes, cells: [(0, false); L], len: 0 }
-    }
-
-    /// Queues cell `(r, c)`; computes and writes the queue when it is full.
-    #[inline(always)]
-    fn push(&mut self, plane: &Plane<'_>, r: usize, c: usize, out: &mut Outputs<'_>) {
-        let ok = fill_one(plane, r, c, self.len, &mut self.lanes);
-        self.cells[self.len] = (r * plane.view.cols + c, ok);
-        self.len += 1;
-        if self.len == L {
-            self.flush(plane, out);
-        }
-    }
-
-    /// Computes the queued cells' features and writes them (stale lanes past `len` are ignored).
-    #[inline(always)]
-    fn flush(&mut self, plane: &Plane<'_>, out: &mut Outputs<'_>) {
-        if self.len == 0 {
-            return;
-        }
-        let mut g = Cells::default();
-        lane_features(&self.lanes, plane.min_pairs, &mut g);
-        for (l, &(i, ok)) in self.cells[..self.len].iter().enumerate() {
-            out.write_one(i, ok, &g, l);
-        }
-        self.len = 0;
-    }
-}
-
 /// The `L` cells of row `r` in chunk `j` (clear of the grid's edges) from the squares of the chunk
 /// below and above the row; cells that lack a direct neighbour go to `queue` (the general search).
 #[allow(clippy::too_many_arguments)]
@@ -488,84 +414,6 @@ fn fast_block(
             }
         }
     }
-}
-
-/// Eq. 1-3 for `L` cells from their neighbour offsets into `out`: the unit normal and `n_rho`
-/// per lane, zeros where a cell has too few pairs or a degenerate sum.
-///
-/// Every lane does the operations of the per-cell definition in its order (sums over `k` from
-/// `d1` to `d8`), except that `1 / |n_i|` and `1 / |n|` come from [`rsqrt`] (relative error below
-/// 5e-6) instead of a square root and a division:
-/// - a pair normal `n_i = d_i x d_(i-1)` exists when both neighbours do and it is not degenerate
-///   (`|n_i|^2 > 1e-24 |d_i|^2 |d_(i-1)|^2`);
-/// - Eq. 2 weight `1 / (|d_i| + |d_(i-1)|)`, Eq. 3 term `(n . n_i) / |n_i|` averaged over pairs.
-#[inline(always)]
-fn lane_features(d: &Lanes, min_pairs: f32, out: &mut Cells) {
-    let (dx, dy, dz, ok, len) = (&d.dx, &d.dy, &d.dz, &d.ok, &d.len);
-    let mut acc = Acc::default();
-    for k in 0..8 {
-        // The previous neighbour of d1 is d8 (Eq. 1's d_(i-1)).
-        let p = (k + 7) % 8;
-        for l in 0..L {
-            let x = dy[k][l] * dz[p][l] - dz[k][l] * dy[p][l];
-            let y = dz[k][l] * dx[p][l] - dx[k][l] * dz[p][l];
-            let z = dx[k][l] * dy[p][l] - dy[k][l] * dx[p][l];
-            let nl2 = x * x + y * y + z * z;
-            // `|n_i| > 1e-12 |d_i| |d_(i-1)|`, squared (no square root).
-            let (lk, lp) = (len[k][l], len[p][l]);
-            let t = lk * lp;
-            // 1 where the pair exists, else 0 (a select, not a conversion).
-            let valid = if nl2 > 1e-24 * t * t { ok[k][l] * ok[p][l] } else { 0.0 };
-            let iv = valid * rsqrt(nl2.max(f32::MIN_POSITIVE));
-            acc.add(l, [x, y, z], iv, valid / (lk + lp).max(f32::MIN_POSITIVE), valid);
-        }
-    }
-    acc.finish(min_pairs, out);
-}
-
-/// Features of `L` cells, lane-wise: the unit normal and `n_rho`.
-#[derive(Default)]
-struct Cells {
-    n: [[f32; L]; 3],
-    rho: [f32; L],
-}
-
-impl Acc {
-    /// Eq. 2-3 from the sums into `out`: the unit normal and `n_rho` per lane, zeros where a
-    /// cell has fewer than `min_pairs` pairs or a degenerate sum.
-    #[inline(always)]
-    fn finish(&self, min_pairs: f32, out: &mut Cells) {
-        let ([sx, sy, sz], [ex, ey, ez], pairs) = (&self.s, &self.e, &self.pairs);
-        let (mut ux, mut uy, mut uz, mut good) = ([0f32; L], [0f32; L], [0f32; L], [false; L]);
-        for l in 0..L {
-            let sum2 = sx[l] * sx[l] + sy[l] * sy[l] + sz[l] * sz[l];
-            good[l] = (pairs[l] >= min_pairs) & (sum2 > 0.0) & sum2.is_finite();
-            // One more Newton step for `n` itself (it is the output).
-            let inv_len = rsqrt_step(sum2, rsqrt(sum2.max(f32::MIN_POSITIVE)));
-            (ux[l], uy[l], uz[l]) = (sx[l] * inv_len, sy[l] * inv_len, sz[l] * inv_len);
-        }
-        // Eq. 3: mean cosine similarity between n and its generating normals.
-        let ([ox, oy, oz], rho) = (&mut out.n, &mut out.rho);
-        for l in 0..L {
-            let q = (ux[l] * ex[l] + uy[l] * ey[l] + uz[l] * ez[l]) / pairs[l];
-            (ox[l], oy[l], oz[l], rho[l]) = if good[l] { (ux[l], uy[l], uz[l], q) } else { (0.0, 0.0, 0.0, 0.0) };
-        }
-    }
-}
-
-/// One Newton step `y (1.5 - x y^2 / 2)` towards `1 / sqrt(x)` from the estimate `y`.
-#[inline(always)]
-fn rsqrt_step(x: f32, y: f32) -> f32 {
-    y * (1.5 - 0.5 * x * y * y)
-}
-
-/// `1 / sqrt(x)` for positive normal `x` within a relative 5e-6: the exponent-halving estimate
-/// (integer operations on the bits) and two Newton steps. Plain arithmetic, so it vectorizes
-/// (no square root or division unit) and gives the same bits on every CPU and code path.
-#[inline(always)]
-fn rsqrt(x: f32) -> f32 {
-    let y = f32::from_bits(0x5f37_5a86u32.wrapping_sub(x.to_bits() >> 1));
-    rsqrt_step(x, rsqrt_step(x, y))
 }
 
 #[cfg(test)]

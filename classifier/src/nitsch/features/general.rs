@@ -100,3 +100,46 @@ pub(super) fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &
     }
     plane.valid[i]
 }
+
+/// Cells of the fast path that lack a direct neighbour, gathered from many blocks so that their
+/// features ([`lane_features`]) run `L` at a time instead of once per block for a few lanes (real
+/// recordings leave empty cells scattered over every ring: half the blocks have one).
+pub(super) struct GeneralQueue {
+    lanes: Lanes,
+    /// Cell index and whether it has a return, per queued lane.
+    cells: [(usize, bool); L],
+    len: usize,
+}
+
+impl GeneralQueue {
+    pub(super) fn new() -> Self {
+        let lanes =
+            Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
+        Self { lanes, cells: [(0, false); L], len: 0 }
+    }
+
+    /// Queues cell `(r, c)`; computes and writes the queue when it is full.
+    #[inline(always)]
+    pub(super) fn push(&mut self, plane: &Plane<'_>, r: usize, c: usize, out: &mut Outputs<'_>) {
+        let ok = fill_one(plane, r, c, self.len, &mut self.lanes);
+        self.cells[self.len] = (r * plane.view.cols + c, ok);
+        self.len += 1;
+        if self.len == L {
+            self.flush(plane, out);
+        }
+    }
+
+    /// Computes the queued cells' features and writes them (stale lanes past `len` are ignored).
+    #[inline(always)]
+    pub(super) fn flush(&mut self, plane: &Plane<'_>, out: &mut Outputs<'_>) {
+        if self.len == 0 {
+            return;
+        }
+        let mut g = Cells::default();
+        lane_features(&self.lanes, plane.min_pairs, &mut g);
+        for (l, &(i, ok)) in self.cells[..self.len].iter().enumerate() {
+            out.write_one(i, ok, &g, l);
+        }
+        self.len = 0;
+    }
+}
