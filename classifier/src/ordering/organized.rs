@@ -138,9 +138,8 @@ pub fn order_organized(
         ..OrderingReport::default()
     };
     for &r in &new_row {
-        for c in 0..cols {
-            report.cell_of_point.push(Some((r * cols + c) as u32));
-        }
+        // A range of known length: `extend` writes it without a capacity check per cell.
+        report.cell_of_point.extend((r * cols..(r + 1) * cols).map(|i| Some(i as u32)));
     }
     report.placed = out.returns();
     report.no_returns = rows * cols - report.placed;
