@@ -161,9 +161,9 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
                 *p = Vec3::new(f(at[0]), f(at[1]), f(at[2]));
             }
         } else {
-            field(&src, pos(Slot::X), b.clone(), |i, v| point_in_vehicle[i].x = v as f32);
-            field(&src, pos(Slot::Y), b.clone(), |i, v| point_in_vehicle[i].y = v as f32);
-            field(&src, pos(Slot::Z), b.clone(), |i, v| point_in_vehicle[i].z = v as f32);
+            field(&src, pos(Slot::X), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.x = v as f32);
+            field(&src, pos(Slot::Y), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.y = v as f32);
+            field(&src, pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.z = v as f32);
         }
         // A file's own `range` field replaces the length below (a return's mark until then).
         let has_range = pos(Slot::Range).is_some();
@@ -177,27 +177,27 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
                 *p = Vec3::NAN;
             }
         }
-        field(&src, pos(Slot::Range), b.clone(), |i, v| {
-            if range_m[i].is_finite() {
-                range_m[i] = if mm { (v * 1e-3) as f32 } else { v as f32 };
+        field(&src, pos(Slot::Range), b.clone(), &mut range_m[b.clone()], |r, v| {
+            if r.is_finite() {
+                *r = if mm { (v * 1e-3) as f32 } else { v as f32 };
             }
         });
-        field(&src, pos(Slot::Intensity), b.clone(), |i, v| intensity[i] = v as f32);
-        field(&src, pos(Slot::Ring), b.clone(), |i, v| ring[i] = v as u16);
-        field(&src, pos(Slot::Column), b.clone(), |i, v| column[i] = v as u32);
-        field(&src, pos(Slot::Sensor), b.clone(), |i, v| sensor[i] = v as u8);
-        field(&src, pos(Slot::Time), b.clone(), |i, v| time_s[i] = if ns { v * 1e-9 } else { v });
-        field(&src, pos(Slot::Echo), b.clone(), |i, v| echo[i] = v as u8);
-        field(&src, pos(Slot::Label), b.clone(), |i, v| label[i] = SemanticClass(v as u16));
-        field(&src, pos(Slot::Instance), b.clone(), |i, v| instance[i] = v as u32);
-        for i in b.clone() {
-            ground[i] = !point_in_vehicle[i].x.is_nan() && label[i].is_ground();
+        field(&src, pos(Slot::Intensity), b.clone(), &mut intensity[b.clone()], |o, v| *o = v as f32);
+        field(&src, pos(Slot::Ring), b.clone(), &mut ring[b.clone()], |o, v| *o = v as u16);
+        field(&src, pos(Slot::Column), b.clone(), &mut column[b.clone()], |o, v| *o = v as u32);
+        field(&src, pos(Slot::Sensor), b.clone(), &mut sensor[b.clone()], |o, v| *o = v as u8);
+        field(&src, pos(Slot::Time), b.clone(), &mut time_s[b.clone()], |o, v| *o = if ns { v * 1e-9 } else { v });
+        field(&src, pos(Slot::Echo), b.clone(), &mut echo[b.clone()], |o, v| *o = v as u8);
+        field(&src, pos(Slot::Label), b.clone(), &mut label[b.clone()], |o, v| *o = SemanticClass(v as u16));
+        field(&src, pos(Slot::Instance), b.clone(), &mut instance[b.clone()], |o, v| *o = v as u32);
+        for ((g, p), l) in ground[b.clone()].iter_mut().zip(&point_in_vehicle[b.clone()]).zip(&label[b.clone()]) {
+            *g = !p.x.is_nan() & l.is_ground();
         }
-        field(&src, pos(Slot::Ground), b.clone(), |i, v| ground[i] = v != 0.0);
+        field(&src, pos(Slot::Ground), b.clone(), &mut ground[b.clone()], |o, v| *o = v != 0.0);
         if normals {
-            field(&src, pos(Slot::Nx), b.clone(), |i, v| normal[i].x = v as f32);
-            field(&src, pos(Slot::Ny), b.clone(), |i, v| normal[i].y = v as f32);
-            field(&src, pos(Slot::Nz), b.clone(), |i, v| normal[i].z = v as f32);
+            field(&src, pos(Slot::Nx), b.clone(), &mut normal[b.clone()], |o, v| o.x = v as f32);
+            field(&src, pos(Slot::Ny), b.clone(), &mut normal[b.clone()], |o, v| o.y = v as f32);
+            field(&src, pos(Slot::Nz), b.clone(), &mut normal[b.clone()], |o, v| o.z = v as f32);
             for m in &mut normal[b] {
                 if !m.is_finite() {
                     *m = Vec3::ZERO;
@@ -238,33 +238,32 @@ enum Source<'a> {
 }
 
 impl Source<'_> {
-    /// Calls `set(i, value)` for the field at `p` of every point `i < n`, in order; the field's type
-    /// is matched once, outside the loop.
+    /// Calls `set(&mut out[i], value)` for the field at `p` of every point of `points` (`out` holds
+    /// their slots, in order); the field's type is matched once, outside the loop, and records and
+    /// slots are zipped (no index checks).
     #[inline(always)]
-    fn each(&self, p: FieldPos, points: std::ops::Range<usize>, mut set: impl FnMut(usize, f64)) {
+    fn each<T>(&self, p: FieldPos, points: std::ops::Range<usize>, out: &mut [T], mut set: impl FnMut(&mut T, f64)) {
         match self {
             Source::Ascii { values, tokens } => {
-                for i in points {
-                    set(i, values[i * tokens + p.token]);
+                for (i, o) in points.zip(out) {
+                    set(o, values[i * tokens + p.token]);
                 }
             }
             Source::Binary { body, record } => {
                 let record = (*record).max(1);
-                let i0 = points.start;
-                let recs = body[i0 * record..points.end * record].chunks_exact(record);
-                let mut set = |i: usize, v: f64| set(i0 + i, v);
+                let recs = body[points.start * record..points.end * record].chunks_exact(record);
                 let at = p.offset;
                 match p.scalar {
                     Scalar::F(4) => recs
-                        .enumerate()
-                        .for_each(|(i, r)| set(i, le4(r, at).map_or(f64::NAN, |b| f64::from(f32::from_le_bytes(b))))),
+                        .zip(out)
+                        .for_each(|(r, o)| set(o, le4(r, at).map_or(f64::NAN, |b| f64::from(f32::from_le_bytes(b))))),
                     Scalar::U(4) => recs
-                        .enumerate()
-                        .for_each(|(i, r)| set(i, le4(r, at).map_or(f64::NAN, |b| f64::from(u32::from_le_bytes(b))))),
-                    Scalar::U(2) => recs.enumerate().for_each(|(i, r)| {
-                        set(i, r.get(at..at + 2).map_or(f64::NAN, |x| f64::from(u16::from_le_bytes([x[0], x[1]]))))
+                        .zip(out)
+                        .for_each(|(r, o)| set(o, le4(r, at).map_or(f64::NAN, |b| f64::from(u32::from_le_bytes(b))))),
+                    Scalar::U(2) => recs.zip(out).for_each(|(r, o)| {
+                        set(o, r.get(at..at + 2).map_or(f64::NAN, |x| f64::from(u16::from_le_bytes([x[0], x[1]]))))
                     }),
-                    s => recs.enumerate().for_each(|(i, r)| set(i, decode_le(s, r.get(at..).unwrap_or(&[])))),
+                    s => recs.zip(out).for_each(|(r, o)| set(o, decode_le(s, r.get(at..).unwrap_or(&[])))),
                 }
             }
         }
@@ -273,9 +272,15 @@ impl Source<'_> {
 
 /// [`Source::each`] for the field at `p`, if the file has it.
 #[inline(always)]
-fn field(src: &Source<'_>, p: Option<FieldPos>, points: std::ops::Range<usize>, set: impl FnMut(usize, f64)) {
+fn field<T>(
+    src: &Source<'_>,
+    p: Option<FieldPos>,
+    points: std::ops::Range<usize>,
+    out: &mut [T],
+    set: impl FnMut(&mut T, f64),
+) {
     if let Some(p) = p {
-        src.each(p, points, set);
+        src.each(p, points, out, set);
     }
 }
 
