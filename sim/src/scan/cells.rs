@@ -63,6 +63,19 @@ pub(super) struct RowView<'c> {
 }
 
 impl RowView<'_> {
+    /// Writes the return fields of `cell` into cell `i` (ring, column, sensor and time are the
+    /// caller's, as for [`RowView::set_no_return`]).
+    #[inline]
+    pub(super) fn set_return(&mut self, i: usize, cell: &Cell) {
+        self.point[i] = cell.point_in_vehicle;
+        self.range[i] = cell.range_m;
+        self.intensity[i] = cell.intensity;
+        self.label[i] = cell.class;
+        self.instance[i] = cell.instance;
+        self.ground[i] = cell.class.is_ground();
+        self.normal[i] = cell.normal;
+    }
+
     /// Writes the no-return defaults of the return fields of cell `i` (as [`OrderedCloud::empty`]
     /// makes them); ring, column, sensor and time are the caller's.
     #[inline]

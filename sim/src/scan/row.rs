@@ -207,15 +207,7 @@ impl Scanner<'_> {
                 first
             };
             match first {
-                Some(cell) => {
-                    view.point[mc] = cell.point_in_vehicle;
-                    view.range[mc] = cell.range_m;
-                    view.intensity[mc] = cell.intensity;
-                    view.label[mc] = cell.class;
-                    view.instance[mc] = cell.instance;
-                    view.ground[mc] = cell.class.is_ground();
-                    view.normal[mc] = cell.normal;
-                }
+                Some(cell) => view.set_return(mc, &cell),
                 None => view.set_no_return(mc),
             }
         }

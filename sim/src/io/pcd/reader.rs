@@ -140,33 +140,13 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
     let mut normal = vec![Vec3::ZERO; n];
     let (mm, ns) = (info.range_in_mm, info.time_in_ns);
     let normals = pos(Slot::Nx).is_some() && pos(Slot::Ny).is_some() && pos(Slot::Nz).is_some();
-    // Binary files with `float` x, y, z (all that we and the drivers write): the three read in one
-    // pass over the records with the no-return test (three passes and a fourth over the points
-    // cost 0.4 ms of a 128 x 1024 frame).
-    let xyz_f32 = match (&src, pos(Slot::X), pos(Slot::Y), pos(Slot::Z)) {
-        (Source::Binary { .. }, Some(x), Some(y), Some(z))
-            if [x, y, z].iter().all(|p| matches!(p.scalar, Scalar::F(4))) =>
-        {
-            Some([x.offset, y.offset, z.offset])
-        }
-        _ => None,
-    };
+    // A file's own `range` field replaces the length below (a return's mark until then).
+    let has_range = pos(Slot::Range).is_some();
     for b0 in (0..n).step_by(BLOCK) {
         let b = b0..(b0 + BLOCK).min(n);
-        if let (Source::Binary { body, record }, Some(at)) = (&src, xyz_f32) {
-            let record = (*record).max(1);
-            let recs = body[b.start * record..b.end * record].chunks_exact(record);
-            for (r, p) in recs.zip(&mut point_in_vehicle[b.clone()]) {
-                let f = |o: usize| le4(r, o).map_or(f32::NAN, f32::from_le_bytes);
-                *p = Vec3::new(f(at[0]), f(at[1]), f(at[2]));
-            }
-        } else {
-            field(&src, pos(Slot::X), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.x = v as f32);
-            field(&src, pos(Slot::Y), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.y = v as f32);
-            field(&src, pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.z = v as f32);
-        }
-        // A file's own `range` field replaces the length below (a return's mark until then).
-        let has_range = pos(Slot::Range).is_some();
+        field(&src, pos(Slot::X), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.x = v as f32);
+        field(&src, pos(Slot::Y), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.y = v as f32);
+        field(&src, pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.z = v as f32);
         for (p, r) in point_in_vehicle[b.clone()].iter_mut().zip(&mut range_m[b.clone()]) {
             // Drivers that keep no-return cells as zeros (ouster-ros, older velodyne): no return.
             let zero = *p == Vec3::ZERO;
