@@ -328,8 +328,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         tests,
         min_pairs: params.min_valid_pairs as f32,
     };
-    let mut lanes =
-        Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
+    let mut lanes = Lanes::default();
     // The fast path needs a row on either side and blocks clear of both edges.
     let inner = if rows >= 3 && cols > L { squares::inner_chunks(cols) } else { 0 };
     // The chunks of row `r` that the fast path below takes; every other block here.

@@ -113,9 +113,7 @@ pub(super) struct GeneralQueue {
 
 impl GeneralQueue {
     pub(super) fn new() -> Self {
-        let lanes =
-            Lanes { dx: [[0.0; L]; 8], dy: [[0.0; L]; 8], dz: [[0.0; L]; 8], ok: [[0.0; L]; 8], len: [[0.0; L]; 8] };
-        Self { lanes, cells: [(0, false); L], len: 0 }
+        Self { lanes: Lanes::default(), cells: [(0, false); L], len: 0 }
     }
 
     /// Queues cell `(r, c)`; computes and writes the queue when it is full.

@@ -7,6 +7,7 @@ use super::L;
 
 /// Neighbour offsets of `L` cells, lane-wise: `dx[k][l]` is `d_(k+1)` of lane `l` (0 where missing in
 /// the general path; `ok` 0 marks a dropped neighbour).
+#[derive(Default)]
 pub(super) struct Lanes {
     pub(super) dx: [[f32; L]; 8],
     pub(super) dy: [[f32; L]; 8],
