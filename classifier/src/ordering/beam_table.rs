@@ -277,13 +277,15 @@ impl TableRows {
     }
 
     /// [`TableRows::nearest_row`]'s `tan(elevation)` (the second value) of the points
-    /// `points[valid[i]]` into `out[i]`, the same bits; `dist[i]` is the point's horizontal
-    /// distance `sqrt(x * x + y * y)`. Two passes: the divisions vectorized, then the row search.
-    pub(crate) fn fine_tans(&self, points: &[glam::Vec3], valid: &[u32], dist: &[f32], out: &mut [f32]) {
+    /// `points[valid[i]]` (every point where `valid` is `None`) into `out[i]`, the same bits;
+    /// `dist[i]` is the point's horizontal distance `sqrt(x * x + y * y)`. Two passes: the
+    /// divisions vectorized, then the row search.
+    pub(crate) fn fine_tans(&self, points: &[glam::Vec3], valid: Option<&[u32]>, dist: &[f32], out: &mut [f32]) {
         let (n, tan, mean_v) = (self.len(), &self.tan_elevation[..], self.mean_vertical_m);
         let (h, v) = (&self.horizontal_m[..n], &self.vertical_m[..n]);
-        for (o, &k) in out.iter_mut().zip(valid) {
-            *o = points[k as usize].z;
+        let z = |i: usize| valid.map_or(points[i].z, |valid| points[valid[i] as usize].z);
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = z(i);
         }
         // Pass 1: `1 / d` per point into `inv`, `t0` into `out` (vectorizes).
         let mut inv = vec![0f32; out.len()];
@@ -292,8 +294,8 @@ impl TableRows {
             *o = (*o - mean_v) * *i;
         }
         // Pass 2: the nearest row's fine value.
-        for ((o, &inv_d), &k) in out.iter_mut().zip(&inv).zip(valid) {
-            let (z, t0) = (points[k as usize].z, *o);
+        for (i, (o, &inv_d)) in out.iter_mut().zip(&inv).enumerate() {
+            let (z, t0) = (z(i), *o);
             let guess = self.guess.rows_below(tan, t0).min(n - 1);
             let inv_d2 = inv_d * inv_d;
             let (lo, hi) = (guess.saturating_sub(2), (guess + 2).min(n - 1));
@@ -424,7 +426,7 @@ mod tests {
         let dist: Vec<f32> =
             valid.iter().map(|&k| (points[k as usize].x.powi(2) + points[k as usize].y.powi(2)).sqrt()).collect();
         let mut got = vec![0.0; valid.len()];
-        rows.fine_tans(&points, &valid, &dist, &mut got);
+        rows.fine_tans(&points, Some(&valid), &dist, &mut got);
         for (g, &k) in got.iter().zip(&valid) {
             assert_eq!(g.to_bits(), rows.nearest_row(points[k as usize]).1.to_bits(), "point {k}");
         }

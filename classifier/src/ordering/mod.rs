@@ -31,6 +31,7 @@ mod polar;
 pub mod report;
 pub mod table;
 pub mod unfold;
+mod usable;
 
 use glam::{Affine3A, Vec3};
 use sim::{OrderedCloud, SemanticClass};
@@ -41,6 +42,8 @@ pub use organized::order_organized;
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};
 pub use unfold::UnfoldParams;
+use unfold::Unfolded;
+use usable::Usable;
 
 use crate::error::{ClassifyError, Result};
 
@@ -58,32 +61,6 @@ pub enum PathChoice {
     BeamTable,
     /// Only unfolding (refused where the order does not unfold).
     Unfold,
-}
-
-/// Indices of the usable points; counts bad points and no-returns in `report`.
-fn usable(points: &[Vec3], report: &mut OrderingReport) -> Result<Vec<u32>> {
-    if points.len() > u32::MAX as usize / 2 {
-        return Err(ClassifyError::Ordering(format!("{} points are too many", points.len())));
-    }
-    let mut valid = Vec::with_capacity(points.len());
-    for (k, p) in points.iter().enumerate() {
-        if !p.is_finite() {
-            report.skipped += 1;
-        } else if *p == Vec3::ZERO {
-            report.no_returns += 1;
-        } else {
-            valid.push(k as u32);
-        }
-    }
-    if report.skipped as f64 > MAX_BAD_FRACTION * points.len() as f64 {
-        return Err(ClassifyError::Ordering(format!(
-            "{} of {} points have NaN or infinite coordinates (at most {} % may)",
-            report.skipped,
-            points.len(),
-            MAX_BAD_FRACTION * 100.0
-        )));
-    }
-    Ok(valid)
 }
 
 /// Orders `points_in_sensor` into the grid of `table`, by unfolding or the beam table as `choice`
@@ -110,27 +87,52 @@ pub fn order_cloud(
         }
     }
     let mut report = OrderingReport { cell_of_point: vec![None; n], ..OrderingReport::default() };
-    let valid = usable(points_in_sensor, &mut report)?;
+    let usable = Usable::find(points_in_sensor, &mut report)?;
     let wishes = match (attributes.rings, choice) {
         (Some(rings), _) => {
             report.path = OrderingPath::RingField;
-            table::ring_wishes(points_in_sensor, &valid, rings, &rows, &mut report).map_err(ClassifyError::Ordering)?
+            table::ring_wishes(points_in_sensor, &usable, rings, &rows, &mut report).map_err(ClassifyError::Ordering)?
         }
         (None, PathChoice::BeamTable) => {
             report.path = OrderingPath::BeamTable;
-            table::table_wishes(points_in_sensor, &valid, &rows, &mut report)
+            table::table_wishes(points_in_sensor, &usable, &rows, &mut report)
         }
         (None, PathChoice::Unfold | PathChoice::Auto) => {
-            match unfold::unfold_wishes(points_in_sensor, &valid, &rows, params, &mut report) {
-                Ok(w) => {
+            match unfold::unfold(points_in_sensor, &usable, &rows, params, &mut report) {
+                Ok(unfolded) => {
                     report.path = OrderingPath::Unfolded;
-                    w
+                    match unfolded {
+                        Unfolded::Wishes(wishes) => wishes,
+                        Unfolded::Rings { bounds, row_of_ring, column, spans_turn } => {
+                            let (cells, planes) = placement::place_rings(
+                                &bounds,
+                                &row_of_ring,
+                                &column,
+                                &spans_turn,
+                                rows.len(),
+                                rows.cols,
+                                &mut report,
+                            );
+                            let cloud = placement::build_cloud(
+                                points_in_sensor,
+                                attributes,
+                                &usable,
+                                &cells,
+                                rows.len(),
+                                rows.cols,
+                                planes,
+                                vehicle_from_sensor,
+                                &mut report,
+                            );
+                            return Ok((cloud, report));
+                        }
+                    }
                 }
                 Err(why) if choice == PathChoice::Auto => {
                     report.path = OrderingPath::BeamTable;
                     report.fallback = Some(why);
                     report.rings_found = 0;
-                    table::table_wishes(points_in_sensor, &valid, &rows, &mut report)
+                    table::table_wishes(points_in_sensor, &usable, &rows, &mut report)
                 }
                 Err(why) => return Err(ClassifyError::Ordering(format!("the points do not unfold: {why}"))),
             }
@@ -140,7 +142,7 @@ pub fn order_cloud(
     let cloud = placement::build_cloud(
         points_in_sensor,
         attributes,
-        &wishes,
+        &usable,
         &cells,
         rows.len(),
         rows.cols,

@@ -11,6 +11,7 @@ use glam::{Affine3A, Vec3};
 use sim::{OrderedCloud, SemanticClass};
 
 use super::report::OrderingReport;
+use super::usable::Usable;
 
 /// How far (columns) a point whose cell and side column are taken looks for a free cell in its row
 /// before it stays on a further plane.
@@ -20,11 +21,12 @@ pub const NEAR_COLUMNS: usize = 16;
 /// decision) instead of being put on a further plane.
 pub const MAX_SHARED_FRACTION: f64 = 0.01;
 
-/// Where one point wants to go.
+/// An owner of no cell.
+const FREE: u32 = u32::MAX;
+
+/// Where one usable point wants to go (wishes are in the order of the usable points).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Wish {
-    /// Input point index.
-    pub point: u32,
     /// Row.
     pub row: u32,
     /// Fractional column steps (column = nearest integer, wrapped for a full turn).
@@ -54,7 +56,6 @@ pub(crate) fn place(
     full_turn: bool,
     report: &mut OrderingReport,
 ) -> (Vec<u32>, usize) {
-    const FREE: u32 = u32::MAX;
     let n = rows * cols;
     // owner[cell] = index into `wishes`; `off` its distance from the column centre.
     let mut owner = vec![FREE; n];
@@ -106,9 +107,9 @@ pub(crate) fn place(
         }
     }
     report.placed = wishes.len() - losers.len();
-    // Losers: the adjacent column on their side if free, else a further plane of their own cell.
-    let mut depth: Vec<u8> = Vec::new();
-    let mut stack: Vec<(u32, usize, u8)> = Vec::new();
+    // Losers: the adjacent column on their side if free, else the nearest free one, else a
+    // further plane of their own cell.
+    let mut stacked = Stacked::new(n);
     for &w in &losers {
         let wish = wishes[w as usize];
         let (c, alt) = match col_of(wish.steps) {
@@ -116,66 +117,153 @@ pub(crate) fn place(
             None => (if wish.steps < 0.0 { 0 } else { cols - 1 }, None),
         };
         let row0 = wish.row as usize * cols;
-        if let Some(a) = alt
-            && owner[row0 + a] == FREE
-        {
-            owner[row0 + a] = w;
-            cell_of_wish[w as usize] = (row0 + a) as u32;
-            report.moved += 1;
-            continue;
+        match free_column_near(&mut owner[row0..row0 + cols], w, c, alt, full_turn) {
+            Some(free) => {
+                cell_of_wish[w as usize] = (row0 + free) as u32;
+                report.moved += 1;
+            }
+            None => stacked.push(w, row0 + c, report),
         }
-        // The nearest free column within `NEAR_COLUMNS` in the same row.
-        if let Some(free) = (2..=NEAR_COLUMNS as isize)
-            .flat_map(|k| [k, -k])
-            .chain([-1, 1])
-            .filter_map(|k| {
-                let c2 = c as isize + k;
-                if full_turn {
-                    Some(c2.rem_euclid(cols as isize) as usize)
-                } else {
-                    usize::try_from(c2).ok().filter(|&a| a < cols)
-                }
-            })
-            .find(|&c2| owner[row0 + c2] == FREE)
-        {
-            owner[row0 + free] = w;
-            cell_of_wish[w as usize] = (row0 + free) as u32;
-            report.moved += 1;
-            continue;
-        }
-        if depth.is_empty() {
-            depth = vec![0; n];
-        }
-        let cell = row0 + c;
-        depth[cell] = depth[cell].saturating_add(1);
-        stack.push((w, cell, depth[cell]));
-        report.stacked += 1;
     }
-    // A handful of such points (under `MAX_SHARED_FRACTION`: a laser's turn overlapping its start)
-    // share their cell's decision rather than cost a whole further plane.
-    if (stack.len() as f64) < MAX_SHARED_FRACTION * wishes.len() as f64 {
-        report.shared = stack.len();
-        report.stacked = 0;
-        for (w, cell, _) in stack {
-            cell_of_wish[w as usize] = cell as u32;
-        }
-        return (cell_of_wish, 1);
-    }
-    let planes = 1 + stack.iter().map(|s| s.2 as usize).max().unwrap_or(0);
-    for (w, cell, d) in stack {
-        cell_of_wish[w as usize] = (d as usize * n + cell) as u32;
-    }
+    let planes = stacked.finish(&mut cell_of_wish, wishes.len(), report);
     (cell_of_wish, planes)
 }
 
-/// Builds the cloud: the points of `wishes` in their cells (`cell_of_wish`), moved to the vehicle
+/// [`place`] for the rings of scan unfolding ([`super::unfold::Unfolded::Rings`]): ring `r` holds
+/// the points `bounds[r] .. bounds[r + 1]` (in order) and goes to row `row_of_ring[r]`, every
+/// point has a whole column (`column`), and `spans_turn[r]` says whether two points of ring `r` may
+/// share a column. A whole column lies at its cell's centre, so [`place`] keeps a cell for the
+/// first point that names it; a ring that does not span a turn names every cell once, and its
+/// points go straight to their cells. The result is [`place`]'s for the same points (tested).
+pub(crate) fn place_rings(
+    bounds: &[usize],
+    row_of_ring: &[usize],
+    column: &[u32],
+    spans_turn: &[bool],
+    rows: usize,
+    cols: usize,
+    report: &mut OrderingReport,
+) -> (Vec<u32>, usize) {
+    let total = column.len();
+    let mut cell_of_point = vec![0u32; total];
+    let mut stacked = Stacked::new(rows * cols);
+    // The cells of a spanning ring's row: FREE or the point that holds the cell.
+    let mut owner: Vec<u32> = Vec::new();
+    let mut losers: Vec<usize> = Vec::new();
+    let mut lost = 0;
+    for ((w, &row), &spans) in bounds.windows(2).zip(row_of_ring).zip(spans_turn) {
+        let row0 = row * cols;
+        let (ring, out) = (&column[w[0]..w[1]], &mut cell_of_point[w[0]..w[1]]);
+        if !spans {
+            for (o, &c) in out.iter_mut().zip(ring) {
+                *o = (row0 + c as usize) as u32;
+            }
+            continue;
+        }
+        owner.clear();
+        owner.resize(cols, FREE);
+        losers.clear();
+        for (i, (o, &c)) in out.iter_mut().zip(ring).enumerate() {
+            let c = c as usize;
+            if owner[c] == FREE {
+                owner[c] = (w[0] + i) as u32;
+                *o = (row0 + c) as u32;
+            } else {
+                losers.push(i);
+            }
+        }
+        lost += losers.len();
+        for &i in &losers {
+            let c = ring[i] as usize;
+            // The side of a whole column is the right one ([`place`]'s `alt`).
+            let alt = if c + 1 < cols { c + 1 } else { 0 };
+            match free_column_near(&mut owner, (w[0] + i) as u32, c, Some(alt), true) {
+                Some(free) => {
+                    out[i] = (row0 + free) as u32;
+                    report.moved += 1;
+                }
+                None => stacked.push((w[0] + i) as u32, row0 + c, report),
+            }
+        }
+    }
+    report.placed = total - lost;
+    let planes = stacked.finish(&mut cell_of_point, total, report);
+    (cell_of_point, planes)
+}
+
+/// A free column for point `w`, which lost column `c` of a row (`owner`: the row's cells, FREE
+/// where free): the adjacent column `alt` on its side if free, else the nearest free one within
+/// [`NEAR_COLUMNS`] (wrapped over a full turn). The column found is taken for `w`.
+fn free_column_near(owner: &mut [u32], w: u32, c: usize, alt: Option<usize>, full_turn: bool) -> Option<usize> {
+    let cols = owner.len();
+    let near = (2..=NEAR_COLUMNS as isize).flat_map(|k| [k, -k]).chain([-1, 1]).filter_map(|k| {
+        let c2 = c as isize + k;
+        if full_turn {
+            Some(c2.rem_euclid(cols as isize) as usize)
+        } else {
+            usize::try_from(c2).ok().filter(|&a| a < cols)
+        }
+    });
+    let free = alt.filter(|&a| owner[a] == FREE).or_else(|| near.into_iter().find(|&c2| owner[c2] == FREE))?;
+    owner[free] = w;
+    Some(free)
+}
+
+/// Points with no free cell nearby: each on a further plane of its own cell (plane 1, 2, ...), or,
+/// when they are fewer than [`MAX_SHARED_FRACTION`] of the points, sharing their cell.
+struct Stacked {
+    /// Cells per plane.
+    n: usize,
+    /// Points stacked so far per cell (allocated with the first).
+    depth: Vec<u8>,
+    /// `(point, cell, plane)` of each.
+    entries: Vec<(u32, usize, u8)>,
+}
+
+impl Stacked {
+    fn new(n: usize) -> Self {
+        Self { n, depth: Vec::new(), entries: Vec::new() }
+    }
+
+    /// Stacks point `w` on its cell `cell` (plane 0 index).
+    fn push(&mut self, w: u32, cell: usize, report: &mut OrderingReport) {
+        if self.depth.is_empty() {
+            self.depth = vec![0; self.n];
+        }
+        self.depth[cell] = self.depth[cell].saturating_add(1);
+        self.entries.push((w, cell, self.depth[cell]));
+        report.stacked += 1;
+    }
+
+    /// Writes the stacked points' cells into `cell_of_point` (`total` points in all) and returns
+    /// the planes of the grid. A handful of such points (under `MAX_SHARED_FRACTION`: a laser's
+    /// turn overlapping its start) share their cell's decision rather than cost a whole further
+    /// plane.
+    fn finish(self, cell_of_point: &mut [u32], total: usize, report: &mut OrderingReport) -> usize {
+        if (self.entries.len() as f64) < MAX_SHARED_FRACTION * total as f64 {
+            report.shared = self.entries.len();
+            report.stacked = 0;
+            for (w, cell, _) in self.entries {
+                cell_of_point[w as usize] = cell as u32;
+            }
+            return 1;
+        }
+        let planes = 1 + self.entries.iter().map(|s| s.2 as usize).max().unwrap_or(0);
+        for (w, cell, d) in self.entries {
+            cell_of_point[w as usize] = (d as usize * self.n + cell) as u32;
+        }
+        planes
+    }
+}
+
+/// Builds the cloud: the usable points in their cells (`cell_of_usable`), moved to the vehicle
 /// frame by `vehicle_from_sensor`; every cell's `ring` is its row and `column` its column.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn build_cloud(
     points_in_sensor: &[Vec3],
     attributes: &PointAttributes<'_>,
-    wishes: &[Wish],
-    cell_of_wish: &[u32],
+    usable: &Usable,
+    cell_of_usable: &[u32],
     rows: usize,
     cols: usize,
     planes: usize,
@@ -212,8 +300,8 @@ pub(crate) fn build_cloud(
     }
     let identity = vehicle_from_sensor == Affine3A::IDENTITY;
     let plane = rows * cols;
-    for (wish, &cell) in wishes.iter().zip(cell_of_wish) {
-        let k = wish.point as usize;
+    for (i, &cell) in cell_of_usable.iter().enumerate() {
+        let k = usable.point(i);
         let cell = cell as usize;
         report.cell_of_point[k] = Some(cell as u32);
         if cloud.range_m[cell].is_finite() {
@@ -237,4 +325,55 @@ pub(crate) fn build_cloud(
         }
     }
     cloud
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    use super::*;
+
+    /// Rings of whole columns, some running past their start (shared columns, moved points, a
+    /// crowded row that stacks), placed by [`place_rings`] and by [`place`]: the same cells, planes
+    /// and counts.
+    #[test]
+    fn rings_are_placed_as_place_places_them() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        let (rows, cols) = (12, 200);
+        let (mut moved, mut stacked, mut shared) = (0, 0, 0);
+        for case in 0..40 {
+            let (mut bounds, mut row_of_ring, mut column, mut spans_turn) =
+                (vec![0], Vec::new(), Vec::new(), Vec::new());
+            let mut row = 0;
+            while row < rows {
+                // Longer than a turn in some cases; a crowded ring (many repeats) in others.
+                let len = rng.random_range(1..if case % 3 == 0 { 260 } else { 190 });
+                let start = rng.random_range(0..cols);
+                let crowd = case % 5 == 0 && row == 3;
+                for i in 0..len {
+                    let c = if crowd { start + i / 3 } else { start + i };
+                    column.push((c % cols) as u32);
+                }
+                spans_turn.push(len >= cols || crowd);
+                bounds.push(column.len());
+                row_of_ring.push(row);
+                row += rng.random_range(1..3);
+            }
+            let wishes: Vec<Wish> = bounds
+                .windows(2)
+                .zip(&row_of_ring)
+                .flat_map(|(w, &r)| column[w[0]..w[1]].iter().map(move |&c| Wish { row: r as u32, steps: c as f32 }))
+                .collect();
+            let mut expected = OrderingReport::default();
+            let want = place(&wishes, rows, cols, true, &mut expected);
+            let mut report = OrderingReport::default();
+            let got = place_rings(&bounds, &row_of_ring, &column, &spans_turn, rows, cols, &mut report);
+            assert_eq!(got, want, "case {case}");
+            assert_eq!(report, expected, "case {case}");
+            (moved, stacked, shared) = (moved + report.moved, stacked + report.stacked, shared + report.shared);
+        }
+        // Every way of settling a point that lost its cell was exercised.
+        assert!(moved > 0 && stacked > 0 && shared > 0, "{moved} moved, {stacked} stacked, {shared} shared");
+    }
 }

@@ -11,9 +11,10 @@ use super::beam_table::fast_atan2;
 /// Points gathered and computed together.
 const LANES: usize = 16;
 
-/// `(azimuth_rad, horizontal_distance_m, tan_elevation)` of `points[k]` for every `k` in `valid`, in
-/// that order; `tan_elevation` is seen from the sensor origin (`z / max(d, 1e-6)`).
-pub(crate) fn polar(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+/// `(azimuth_rad, horizontal_distance_m, tan_elevation)` of `points[k]` for every `k` in `valid`
+/// (every point where `valid` is `None`), in that order; `tan_elevation` is seen from the sensor
+/// origin (`z / max(d, 1e-6)`).
+pub(crate) fn polar(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
@@ -28,20 +29,30 @@ pub(crate) fn polar(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<
 /// [`polar_body`] compiled for AVX2 (plain IEEE operations only: the same bits as without it).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn polar_avx2(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+fn polar_avx2(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     polar_body(points, valid)
 }
 
 #[inline(always)]
-fn polar_body(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
-    let m = valid.len();
+fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+    let m = valid.map_or(points.len(), <[u32]>::len);
     let (mut az, mut dist, mut fine) = (vec![0.0f32; m], vec![0.0f32; m], vec![0.0f32; m]);
-    let chunks = valid.chunks(LANES).zip(az.chunks_mut(LANES)).zip(dist.chunks_mut(LANES).zip(fine.chunks_mut(LANES)));
-    for ((idx, a), (d, f)) in chunks {
+    let outputs = az.chunks_mut(LANES).zip(dist.chunks_mut(LANES).zip(fine.chunks_mut(LANES)));
+    for (j, (a, (d, f))) in outputs.enumerate() {
         let (mut x, mut y, mut z) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
-        for (l, &k) in idx.iter().enumerate() {
-            let p = points[k as usize];
-            (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+        let n = a.len();
+        match valid {
+            Some(valid) => {
+                for (l, &k) in valid[j * LANES..j * LANES + n].iter().enumerate() {
+                    let p = points[k as usize];
+                    (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+                }
+            }
+            None => {
+                for (l, p) in points[j * LANES..j * LANES + n].iter().enumerate() {
+                    (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+                }
+            }
         }
         let (mut oa, mut od, mut of) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
         for l in 0..LANES {
@@ -49,7 +60,6 @@ fn polar_body(points: &[Vec3], valid: &[u32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) 
             od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
             of[l] = z[l] / od[l].max(1e-6);
         }
-        let n = idx.len();
         a.copy_from_slice(&oa[..n]);
         d.copy_from_slice(&od[..n]);
         f.copy_from_slice(&of[..n]);
@@ -99,7 +109,11 @@ mod tests {
             pts.push(Vec3::new(r * t.cos(), r * t.sin(), -1.7));
         }
         let valid: Vec<u32> = (0..pts.len() as u32).rev().collect();
-        let (az, dist, fine) = polar(&pts, &valid);
+        let (az, dist, fine) = polar(&pts, Some(&valid));
+        let (all_az, _, _) = polar(&pts, None);
+        for (j, &k) in valid.iter().enumerate() {
+            assert_eq!(all_az[k as usize].to_bits(), az[j].to_bits());
+        }
         for (j, &k) in valid.iter().enumerate() {
             let p = pts[k as usize];
             assert_eq!(az[j].to_bits(), fast_atan2(p.y, p.x).to_bits(), "azimuth of {p:?}");
@@ -108,8 +122,7 @@ mod tests {
             assert_eq!(fine[j].to_bits(), (p.z / d.max(1e-6)).to_bits());
         }
         // Spot values against libm.
-        let (az, _, _) =
-            polar(&[Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, -2.0, 0.0), Vec3::new(1.0, 1.0, 0.0)], &[0, 1, 2]);
+        let (az, _, _) = polar(&[Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, -2.0, 0.0), Vec3::new(1.0, 1.0, 0.0)], None);
         assert!((az[0] - std::f32::consts::PI).abs() < 1e-6);
         assert!((az[1] + std::f32::consts::FRAC_PI_2).abs() < 1e-6);
         assert!((az[2] - std::f32::consts::FRAC_PI_4).abs() < 1e-6);

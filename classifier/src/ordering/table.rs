@@ -8,34 +8,40 @@ use glam::Vec3;
 use super::beam_table::TableRows;
 use super::placement::Wish;
 use super::report::OrderingReport;
+use super::usable::Usable;
 
-/// The wish of every point in `valid` (indices of usable points) from the table alone.
-pub(crate) fn table_wishes(points: &[Vec3], valid: &[u32], rows: &TableRows, report: &mut OrderingReport) -> Vec<Wish> {
-    let mut wishes = Vec::with_capacity(valid.len());
-    for &k in valid {
+/// The wish of every usable point from the table alone.
+pub(crate) fn table_wishes(
+    points: &[Vec3],
+    usable: &Usable,
+    rows: &TableRows,
+    report: &mut OrderingReport,
+) -> Vec<Wish> {
+    let mut wishes = Vec::with_capacity(usable.len());
+    for k in usable.iter() {
         let p = points[k as usize];
         let (row, _, outside) = rows.nearest_row(p);
         report.outside += usize::from(outside);
         let steps = rows.column_steps(rows.beam_azimuth(p, row));
-        wishes.push(Wish { point: k, row: row as u32, steps });
+        wishes.push(Wish { row: row as u32, steps });
     }
     wishes
 }
 
-/// The wish of every point in `valid` from its `ring` field: rows are the rings, bottom-first or
+/// The wish of every usable point from its `ring` field: rows are the rings, bottom-first or
 /// top-first as the rings' median elevations go (ring 0 at the bottom for velodyne, at the top for
 /// ouster); columns from the beam azimuth. Refused for a ring value beyond the table's rows, or a
 /// way up that cannot be told (fewer than two rings with points, or no difference in elevation).
 pub(crate) fn ring_wishes(
     points: &[Vec3],
-    valid: &[u32],
+    usable: &Usable,
     rings: &[u16],
     rows: &TableRows,
     report: &mut OrderingReport,
 ) -> Result<Vec<Wish>, String> {
     let n = rows.len();
     let mut sums = vec![(0.0f64, 0usize); n];
-    for &k in valid {
+    for k in usable.iter() {
         let g = rings[k as usize] as usize;
         if g >= n {
             return Err(format!("point {k} has ring {g}, out of range 0 ..= {} (the beam table's rows)", n - 1));
@@ -66,12 +72,12 @@ pub(crate) fn ring_wishes(
         return Err(format!("cannot tell which way the rings go ({up} steps up, {down} down in elevation)"));
     };
     report.rings_found = means.len();
-    let mut wishes = Vec::with_capacity(valid.len());
-    for &k in valid {
+    let mut wishes = Vec::with_capacity(usable.len());
+    for k in usable.iter() {
         let g = rings[k as usize] as usize;
         let row = if bottom_first { g } else { n - 1 - g };
         let p = points[k as usize];
-        wishes.push(Wish { point: k, row: row as u32, steps: rows.column_steps(rows.beam_azimuth(p, row)) });
+        wishes.push(Wish { row: row as u32, steps: rows.column_steps(rows.beam_azimuth(p, row)) });
     }
     Ok(wishes)
 }

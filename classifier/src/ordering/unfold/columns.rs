@@ -1,0 +1,183 @@
+//! Columns of an unfolded ring: each point's beam azimuth in column steps, unwrapped along the ring
+//! and kept strictly moving in the scan direction (a counter-clockwise turn goes down the columns):
+//! a point whose column is taken by its predecessor takes the next one, the nearest free cell in
+//! scan order. A step back of more than [`MAX_BACK_COLUMNS`] (jitter, parallax) is a gap going
+//! forward the long way round.
+//!
+//! The steps, their unwrapping increments and the rounding are vectorized passes; the running sum
+//! and the step that keeps columns moving are serial, the latter on integers (columns are whole
+//! numbers there, so the float comparisons of the rule are exact integer ones). A ring whose
+//! unwrapped columns could leave the range where that holds (beyond `2^23`: only for absurd input)
+//! takes the float rule instead ([`columns_by_float_rule`]), which gives the same columns wherever
+//! both apply (tested).
+
+use super::super::beam_table::{TableRows, round_fast, wrap_into};
+use super::wrap_once;
+
+/// Within a ring, a step of the columns against the scan direction by more than this is a gap
+/// going forward the long way round, not a step back.
+pub(crate) const MAX_BACK_COLUMNS: f32 = 8.0;
+
+/// Largest unwrapped column (absolute) for the integer rule: well inside the integers that `f32`
+/// holds exactly, with room for a ring's worth of steps.
+const EXACT_COLUMNS: f32 = (1u32 << 23) as f32;
+
+/// [`wrap_into`] of every value, in place: one add or subtract (a select that vectorizes) where
+/// every value lies within a turn of `[0, period)`, else [`wrap_into`] itself.
+fn wrap_all(v: &mut [f32], period: f32) {
+    let (lo, hi) = (-period, 2.0 * period);
+    let outside = v.iter().fold(0u32, |n, &x| n + u32::from((x < lo) | (x >= hi)));
+    if outside == 0 {
+        v.iter_mut().for_each(|x| *x = wrap_once(*x, period));
+    } else {
+        v.iter_mut().for_each(|x| *x = wrap_into(*x, period));
+    }
+}
+
+/// [`round_fast`] of every value, in place (selects that vectorize); values are column counts,
+/// far inside the `i32` range where this equals `round_fast`.
+fn round_all(v: &mut [f32]) {
+    for x in v {
+        let y = *x + 0.5;
+        let t = y as i32 as f32;
+        *x = if t > y { t - 1.0 } else { t };
+    }
+}
+
+/// Fractional column steps of the beam azimuths of points with azimuths `az` and horizontal
+/// distances `dist` in row `row` ([`TableRows::column_steps`] of [`TableRows::beam_azimuth`]),
+/// into `steps`.
+pub(crate) fn column_steps(rows: &TableRows, row: usize, az: &[f32], dist: &[f32], steps: &mut Vec<f32>) {
+    let h = rows.horizontal_m[row];
+    steps.clear();
+    if h == 0.0 {
+        let (left, step) = (rows.azimuth_left_rad, rows.azimuth_step_rad);
+        steps.extend(az.iter().map(|&a| (left - a) / step));
+        if rows.full_turn {
+            wrap_all(steps, std::f32::consts::TAU / step);
+        }
+    } else {
+        steps.extend(az.iter().zip(dist).map(|(&a, &d)| rows.column_steps(a - (h / d.max(h.abs() * 1.0001)).asin())));
+    }
+}
+
+/// Reusable buffers of [`ring_columns`].
+#[derive(Default)]
+pub(crate) struct ColumnScratch {
+    steps: Vec<f32>,
+    unwrapped: Vec<f32>,
+}
+
+/// The whole columns (in `[0, cols)`) of one ring's points in a full-turn grid, from their
+/// azimuths and distances, into `out`; the scan goes down the columns when `dir` (the turn's
+/// direction) is +1. Returns whether the ring's columns span a full turn, so that two of its
+/// points may share a column.
+pub(crate) fn ring_columns(
+    rows: &TableRows,
+    row: usize,
+    az: &[f32],
+    dist: &[f32],
+    dir: f32,
+    scratch: &mut ColumnScratch,
+    out: &mut [u32],
+) -> bool {
+    let ColumnScratch { steps, unwrapped } = scratch;
+    column_steps(rows, row, az, dist, steps);
+    let (cols, col_dir) = (rows.cols as f32, -dir);
+    // Progress in the scan direction, in columns: the increments as one pass, the sum in point
+    // order.
+    unwrapped.clear();
+    unwrapped.push(steps[0]);
+    unwrapped.extend(
+        steps.windows(2).map(|pair| {
+            (wrap_once((pair[1] - pair[0]) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS) * col_dir
+        }),
+    );
+    let mut u = 0.0f32;
+    let mut largest = 0.0f32;
+    for (k, x) in unwrapped.iter_mut().enumerate() {
+        u = if k == 0 { *x } else { u + *x };
+        *x = u;
+        largest = largest.max(u.abs());
+    }
+    round_all(unwrapped);
+    if largest >= EXACT_COLUMNS {
+        return columns_by_float_rule(unwrapped, rows.cols, col_dir, out);
+    }
+    // The rule `c' = c` unless `(c - last) * col_dir < 1`, then `last + col_dir`, on whole
+    // numbers: a running maximum (scan going up the columns) or minimum.
+    let cols_i = rows.cols as i32;
+    let first = unwrapped[0] as i32;
+    let mut last = first - col_dir as i32;
+    if col_dir > 0.0 {
+        for (o, &c) in out.iter_mut().zip(unwrapped.iter()) {
+            last = (c as i32).max(last + 1);
+            *o = last.rem_euclid(cols_i) as u32;
+        }
+    } else {
+        for (o, &c) in out.iter_mut().zip(unwrapped.iter()) {
+            last = (c as i32).min(last - 1);
+            *o = last.rem_euclid(cols_i) as u32;
+        }
+    }
+    (last - first).abs() >= cols_i
+}
+
+/// The moving rule in floats as first written (for unwrapped columns beyond [`EXACT_COLUMNS`]).
+fn columns_by_float_rule(unwrapped: &[f32], cols: usize, col_dir: f32, out: &mut [u32]) -> bool {
+    let mut last = unwrapped[0] - col_dir;
+    for (o, &c) in out.iter_mut().zip(unwrapped) {
+        let c = if (c - last) * col_dir < 1.0 { last + col_dir } else { c };
+        last = c;
+        // A whole number in [0, cols) (the wrap of a whole number of columns is one).
+        *o = round_fast(wrap_into(c, cols as f32)) as u32;
+    }
+    // Not known to stay clear of its own start: placed with the check of every cell.
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::beam_table::BeamTable;
+    use super::*;
+
+    /// The rule as first written, per point, for comparison.
+    fn reference(rows: &TableRows, az: &[f32], dir: f32) -> Vec<u32> {
+        let (cols, col_dir) = (rows.cols as f32, -dir);
+        let steps: Vec<f32> = az.iter().map(|&a| rows.column_steps(a)).collect();
+        let mut u = steps[0];
+        let mut unwrapped = vec![u];
+        for pair in steps.windows(2) {
+            u += (wrap_once((pair[1] - pair[0]) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS) * col_dir;
+            unwrapped.push(u);
+        }
+        let mut out = vec![0; az.len()];
+        round_all(&mut unwrapped);
+        columns_by_float_rule(&unwrapped, rows.cols, col_dir, &mut out);
+        out
+    }
+
+    #[test]
+    fn columns_equal_the_float_rule() {
+        let rows = BeamTable::hdl64e(2170).rows().unwrap();
+        let mut scratch = ColumnScratch::default();
+        for (case, dir) in [(0usize, 1.0f32), (1, -1.0), (2, 1.0), (3, -1.0)] {
+            // A ring with jitter, repeated azimuths, half steps and a step back, and (cases 2, 3)
+            // more than a full turn.
+            let n = if case < 2 { 2_000 } else { 2_300 };
+            let az: Vec<f32> = (0..n)
+                .map(|i| {
+                    let a =
+                        dir * (i as f32 * 0.002_95 + ((i * 7) % 5) as f32 * 4e-4 - if i == 700 { 0.02 } else { 0.0 });
+                    (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
+                })
+                .collect();
+            let dist = vec![10.0; n];
+            let mut out = vec![0u32; n];
+            let spans = ring_columns(&rows, 0, &az, &dist, dir, &mut scratch, &mut out);
+            assert_eq!(out, reference(&rows, &az, dir), "case {case}");
+            assert_eq!(spans, case >= 2, "case {case}");
+            assert!(out.iter().all(|&c| (c as usize) < rows.cols));
+        }
+    }
+}

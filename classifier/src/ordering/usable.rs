@@ -1,0 +1,104 @@
+//! The usable points of a cloud: those with finite coordinates that are not the (0, 0, 0) a
+//! driver writes for a no-return. Bad points (NaN, infinite) are counted and skipped, and more
+//! than [`MAX_BAD_FRACTION`] of them refuse the cloud; no-returns are counted and skipped.
+//!
+//! Real files rarely hold either, so the common case keeps no index list at all: usable point `i`
+//! is input point `i` ([`Usable::point`]), and the passes over the points read them contiguously.
+
+use glam::Vec3;
+
+use super::MAX_BAD_FRACTION;
+use super::report::OrderingReport;
+use crate::error::{ClassifyError, Result};
+
+/// Which input points are usable, in input order.
+#[derive(Clone, Debug)]
+pub(crate) struct Usable {
+    /// Input index of each usable point; `None` when every point is usable.
+    idx: Option<Vec<u32>>,
+    len: usize,
+}
+
+impl Usable {
+    /// Finds the usable points of `points`, counting bad points and no-returns in `report`.
+    pub(crate) fn find(points: &[Vec3], report: &mut OrderingReport) -> Result<Self> {
+        if points.len() > u32::MAX as usize / 2 {
+            return Err(ClassifyError::Ordering(format!("{} points are too many", points.len())));
+        }
+        // A counting pass without branches (it vectorizes); the index list only where needed.
+        let (mut bad, mut zero) = (0usize, 0usize);
+        for p in points {
+            let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+            bad += usize::from(!finite);
+            zero += usize::from((p.x == 0.0) & (p.y == 0.0) & (p.z == 0.0));
+        }
+        report.skipped += bad;
+        report.no_returns += zero;
+        if report.skipped as f64 > MAX_BAD_FRACTION * points.len() as f64 {
+            return Err(ClassifyError::Ordering(format!(
+                "{} of {} points have NaN or infinite coordinates (at most {} % may)",
+                report.skipped,
+                points.len(),
+                MAX_BAD_FRACTION * 100.0
+            )));
+        }
+        if bad + zero == 0 {
+            return Ok(Self { idx: None, len: points.len() });
+        }
+        let idx: Vec<u32> = (0..points.len() as u32)
+            .filter(|&k| points[k as usize].is_finite() && points[k as usize] != Vec3::ZERO)
+            .collect();
+        Ok(Self { len: idx.len(), idx: Some(idx) })
+    }
+
+    /// Number of usable points.
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Input index of usable point `i`.
+    #[inline(always)]
+    pub(crate) fn point(&self, i: usize) -> usize {
+        match &self.idx {
+            None => i,
+            Some(idx) => idx[i] as usize,
+        }
+    }
+
+    /// The input indices as a list, `None` when every point is usable (index = position).
+    pub(crate) fn indices(&self) -> Option<&[u32]> {
+        self.idx.as_deref()
+    }
+
+    /// Input indices of the usable points, in order.
+    pub(crate) fn iter(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.len).map(|i| self.point(i) as u32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_bad_points_and_no_returns_and_lists_the_rest() {
+        let mut pts = vec![Vec3::new(1.0, 2.0, 3.0); 300];
+        pts[5] = Vec3::ZERO;
+        pts[7] = Vec3::new(f32::NAN, 0.0, 0.0);
+        pts[9] = Vec3::new(0.0, f32::INFINITY, 0.0);
+        let mut report = OrderingReport::default();
+        let u = Usable::find(&pts, &mut report).unwrap();
+        assert_eq!((report.skipped, report.no_returns, u.len()), (2, 1, 297));
+        assert_eq!((u.point(4), u.point(5), u.point(6), u.point(7)), (4, 6, 8, 10));
+        assert_eq!(u.iter().count(), 297);
+        let mut report = OrderingReport::default();
+        let all = Usable::find(&pts[10..], &mut report).unwrap();
+        assert!(all.indices().is_none());
+        assert_eq!((all.len(), all.point(17), report.skipped + report.no_returns), (290, 17, 0));
+        // More than 1 % bad: refused.
+        pts[11] = Vec3::NAN;
+        pts[12] = Vec3::NAN;
+        let mut report = OrderingReport::default();
+        assert!(Usable::find(&pts[..100], &mut report).is_err());
+    }
+}
