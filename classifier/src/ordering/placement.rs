@@ -298,33 +298,58 @@ pub(crate) fn build_cloud(
             *v = c as u32;
         }
     }
-    let identity = vehicle_from_sensor == Affine3A::IDENTITY;
     let plane = rows * cols;
     for (i, &cell) in cell_of_usable.iter().enumerate() {
-        let k = usable.point(i);
-        let cell = cell as usize;
-        report.cell_of_point[k] = Some(cell as u32);
-        if cloud.range_m[cell].is_finite() {
-            // A shared cell keeps its first point.
-            continue;
-        }
-        let p = points_in_sensor[k];
-        cloud.point_in_vehicle[cell] = if identity { p } else { vehicle_from_sensor.transform_point3(p) };
-        cloud.range_m[cell] = p.length();
-        cloud.sensor[cell] = 0;
-        cloud.echo[cell] = if cell < plane { 0 } else { (cell / plane) as u8 };
-        if let Some(v) = attributes.intensity {
-            cloud.intensity[cell] = v[k];
-        }
-        if let Some(t) = attributes.time_s {
-            cloud.time_s[cell] = t[k];
-        }
-        if let Some(l) = attributes.labels {
-            cloud.label[cell] = l[k];
-            cloud.ground[cell] = l[k].is_ground();
+        report.cell_of_point[usable.point(i)] = Some(cell);
+    }
+    // Each field a plain scatter into the cells, in reverse order: where points share a cell, the
+    // first one's values are written last and stay (a shared cell keeps its first point).
+    let transform = (vehicle_from_sensor != Affine3A::IDENTITY).then_some(vehicle_from_sensor);
+    match usable.indices() {
+        None => scatter(&mut cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| i),
+        Some(idx) => scatter(&mut cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| idx[i] as usize),
+    }
+    if planes > 1 {
+        for &cell in cell_of_usable {
+            cloud.echo[cell as usize] = (cell as usize / plane) as u8;
         }
     }
     cloud
+}
+
+/// Writes the points (usable point `i` is input point `point(i)`, its cell `cells[i]`) and their
+/// attributes into `cloud`'s cells, last point first.
+#[inline(always)]
+fn scatter(
+    cloud: &mut OrderedCloud,
+    points_in_sensor: &[Vec3],
+    attributes: &PointAttributes<'_>,
+    cells: &[u32],
+    transform: Option<Affine3A>,
+    point: impl Fn(usize) -> usize,
+) {
+    for (i, &cell) in cells.iter().enumerate().rev() {
+        let (p, cell) = (points_in_sensor[point(i)], cell as usize);
+        cloud.point_in_vehicle[cell] = transform.map_or(p, |t| t.transform_point3(p));
+        cloud.range_m[cell] = p.length();
+        cloud.sensor[cell] = 0;
+    }
+    if let Some(v) = attributes.intensity {
+        for (i, &cell) in cells.iter().enumerate().rev() {
+            cloud.intensity[cell as usize] = v[point(i)];
+        }
+    }
+    if let Some(t) = attributes.time_s {
+        for (i, &cell) in cells.iter().enumerate().rev() {
+            cloud.time_s[cell as usize] = t[point(i)];
+        }
+    }
+    if let Some(l) = attributes.labels {
+        for (i, &cell) in cells.iter().enumerate().rev() {
+            let l = l[point(i)];
+            (cloud.label[cell as usize], cloud.ground[cell as usize]) = (l, l.is_ground());
+        }
+    }
 }
 
 #[cfg(test)]
