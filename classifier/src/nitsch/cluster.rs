@@ -65,7 +65,7 @@ use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
 use crate::nitsch::neighbours::GridView;
-use crate::nitsch::return_bits::{self, ReturnBits};
+use crate::nitsch::row_returns::RowReturns;
 
 /// Parameters of clustering and of the cluster rules.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -175,8 +175,8 @@ pub struct ClusterWorkspace {
     valid: Vec<bool>,
     /// Per column of the row being clustered: returns in the rows below, at and above.
     column_valid: Vec<bool>,
-    /// `valid` as bits, for the neighbour search of cells that lack a direct neighbour.
-    bits: ReturnBits,
+    /// The tables of the neighbour search of cells that lack a direct neighbour.
+    search: RowReturns,
     /// Cluster roots in increasing order (the per-root arrays are only read and reset there).
     roots: Vec<u32>,
     /// Returns of the plane of the last clustering.
@@ -323,7 +323,7 @@ fn cluster_body(
         }
     }
     ws.returns = ws.valid.iter().map(|&v| usize::from(v)).sum();
-    ws.bits.pack(&ws.valid[..n], rows, cols);
+    ws.search.build(view, &ws.valid[..n]);
     // Only cells with a return can be candidates: the members, each its own root to begin with.
     ws.parent.clear();
     ws.parent.resize(n, NONE);
@@ -403,7 +403,8 @@ fn cluster_body(
                     }
                 }
             } else {
-                for j in return_bits::neighbours(view, &ws.bits, r, c).into_iter().flatten() {
+                // A missing neighbour is the cell itself, which never links to itself.
+                for j in ws.search.neighbours_or(view, r, c, i) {
                     if parent[j] != NONE {
                         // The unions above may have moved this cell's root.
                         ri = find(parent, ri);

@@ -44,7 +44,7 @@ use glam::Vec3;
 
 use crate::error::{ClassifyError, Result};
 use crate::nitsch::neighbours::GridView;
-use crate::nitsch::return_bits::ReturnBits;
+use crate::nitsch::row_returns::RowReturns;
 use general::{GeneralQueue, general_block};
 use lanes::{Acc, Cells, Lanes, lane_features, rsqrt};
 
@@ -126,8 +126,8 @@ struct Soa {
     edge: Vec<[f32; squares::SQUARE_FIELDS]>,
     /// Horizontal edge lengths of the row being processed, by column.
     horizontal: Vec<f32>,
-    /// `valid` as bits, for the general neighbour search.
-    bits: ReturnBits,
+    /// The tables of the general neighbour search.
+    search: RowReturns,
 }
 
 impl Features {
@@ -236,7 +236,7 @@ struct Plane<'a> {
     y: &'a [f32],
     z: &'a [f32],
     valid: &'a [bool],
-    bits: &'a ReturnBits,
+    search: &'a RowReturns,
     tests: Tests,
     min_pairs: f32,
 }
@@ -308,7 +308,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         // `is_valid` without short-circuit branches, so that the loop vectorizes.
         (xs[i], ys[i], zs[i], valid[i]) = (p.x, p.y, p.z, p.x.is_finite() & p.y.is_finite() & p.z.is_finite());
     }
-    soa.bits.pack(&soa.valid[..n], rows, cols);
+    soa.search.build(view, &soa.valid[..n]);
     // Ratio 0 switches the test off (keep every neighbour: factor 0).
     let factor = |ratio: f32| if ratio > 0.0 { 1.0 - ratio } else { 0.0 };
     let (up, other) = (factor(params.upper_occlusion_ratio), factor(params.occlusion_ratio));
@@ -324,7 +324,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
         y: &soa.y[..n],
         z: &soa.z[..n],
         valid: &soa.valid[..n],
-        bits: &soa.bits,
+        search: &soa.search,
         tests,
         min_pairs: params.min_valid_pairs as f32,
     };

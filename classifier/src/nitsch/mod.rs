@@ -10,7 +10,7 @@
 pub mod cluster;
 pub mod features;
 pub mod neighbours;
-mod return_bits;
+mod row_returns;
 pub mod row_order;
 
 use glam::Vec3;

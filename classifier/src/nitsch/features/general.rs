@@ -1,11 +1,10 @@
 //! The cells whose neighbours are not all their direct grid neighbours: the grid's first and last
 //! rows and blocks, and cells next to a missing return, whose neighbours come from the general
-//! search ([`crate::nitsch::return_bits`]) and whose pair normals are their own cross products.
+//! search ([`crate::nitsch::row_returns`]) and whose pair normals are their own cross products.
 
 #![allow(clippy::needless_range_loop)]
 
 use super::*;
-use crate::nitsch::return_bits;
 
 /// The `m` cells of row `r` from column `c0` on, by the general neighbour search.
 #[inline(always)]
@@ -82,20 +81,22 @@ fn direct_lanes(plane: &Plane<'_>, r: usize, c0: usize, m: usize, lanes: &mut La
 }
 
 /// Offsets of cell `(r, c)` into lane `l` by the general neighbour search; false if it has no return.
+///
+/// Without branches per neighbour: a missing neighbour is the cell itself, whose offset (zero)
+/// fails the neighbour test as a missing one would, and a cell without a return fails it for
+/// every neighbour (NaN offsets): both give the zeros of a missing neighbour.
 #[inline]
 pub(super) fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &mut Lanes) -> bool {
     let (view, tests, ranges) = (plane.view, &plane.tests, plane.view.ranges);
     let i = r * view.cols + c;
-    let nb = if plane.valid[i] { return_bits::neighbours(view, plane.bits, r, c) } else { [None; 8] };
+    let nb = plane.search.neighbours_or(view, r, c, i);
+    let (px, py, pz, pr) = (plane.x[i], plane.y[i], plane.z[i], ranges[i]);
     for (k, j) in nb.into_iter().enumerate() {
-        let (mut d, mut ok) = ([0.0; 3], 0.0);
-        if let Some(j) = j {
-            let dj = [plane.x[j] - plane.x[i], plane.y[j] - plane.y[i], plane.z[j] - plane.z[i]];
-            if tests.keep(k, dj[0] * dj[0] + dj[1] * dj[1] + dj[2] * dj[2], ranges[j], ranges[i]) {
-                (d, ok) = (dj, 1.0);
-            }
-        }
-        (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l], lanes.ok[k][l]) = (d[0], d[1], d[2], ok);
+        let d = [plane.x[j] - px, plane.y[j] - py, plane.z[j] - pz];
+        let keep = tests.keep(k, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], ranges[j], pr);
+        let d = if keep { d } else { [0.0; 3] };
+        (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
+        lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
         lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     }
     plane.valid[i]
