@@ -116,14 +116,21 @@ impl RowReturns {
         let mut out = [missing; 8];
         out[2] = self.along(r, c, 1, missing);
         out[6] = self.along(r, c, -1, missing);
-        // The nearest row above (below) with a return near the column, skipping empty rows.
-        if let Some([centre, right, left]) = (r + 1..self.rows.min(r + 1 + MAX_ROW_GAP)).find_map(|up| self.side(up, c, missing)) {
-            (out[0], out[1], out[7]) = (centre, right, left);
+        // The nearest row above (below) with a return near the column, skipping empty rows (plain
+        // loops: iterator adaptors here were left as calls).
+        for up in r + 1..self.rows.min(r + 1 + MAX_ROW_GAP) {
+            if let Some([centre, right, left]) = self.side(up, c, missing) {
+                (out[0], out[1], out[7]) = (centre, right, left);
+                break;
+            }
         }
-        if let Some([centre, right, left]) =
-            (r.saturating_sub(MAX_ROW_GAP)..r).rev().find_map(|dn| self.side(dn, c, missing))
-        {
-            (out[4], out[3], out[5]) = (centre, right, left);
+        let mut dn = r;
+        while dn > r.saturating_sub(MAX_ROW_GAP) {
+            dn -= 1;
+            if let Some([centre, right, left]) = self.side(dn, c, missing) {
+                (out[4], out[3], out[5]) = (centre, right, left);
+                break;
+            }
         }
         out
     }
