@@ -406,10 +406,16 @@ fn fast_block(
     out.write(i0, L, &[true; L], &f);
     if !dense {
         // Some cells lack a direct neighbour: those again by the general search (their lanes above
-        // are overwritten when the queue is computed).
+        // are overwritten when the queue is computed), but for the cells without a return (the
+        // holes themselves, a third of them on a KITTI frame), whose features are zeros.
+        let valid = &plane.valid[i0..i0 + L];
         for l in 0..L {
             if !(cv[l] & cv[l + 1] & cv[l + 2]) {
-                queue.push(plane, r, c0 + l, out);
+                if valid[l] {
+                    queue.push(plane, r, c0 + l, out);
+                } else {
+                    out.zero(i0 + l, 1);
+                }
             }
         }
     }
