@@ -125,11 +125,12 @@ pub fn order_organized(
     }
     permute!(point_in_vehicle, range_m, intensity, ring, column, sensor, time_s, echo, label, instance, ground, normal);
     if vehicle_from_sensor != glam::Affine3A::IDENTITY {
-        for p in out.point_in_vehicle.iter_mut().filter(|p| p.is_finite()) {
-            *p = vehicle_from_sensor.transform_point3(*p);
-        }
-        for n in out.normal.iter_mut() {
-            *n = vehicle_from_sensor.transform_vector3(*n);
+        super::transform_returns(vehicle_from_sensor, &mut out.point_in_vehicle);
+        // The drivers' layouts carry no normals: zero normals stay zero.
+        if out.normal.iter().any(|n| *n != glam::Vec3::ZERO) {
+            for n in out.normal.iter_mut() {
+                *n = vehicle_from_sensor.transform_vector3(*n);
+            }
         }
     }
     let mut report = OrderingReport {
@@ -152,10 +153,26 @@ pub fn is_top_first(report: &OrderingReport, rows: usize, cols: usize) -> bool {
     rows > 1 && report.cell_of_point.first().copied().flatten().is_some_and(|c| c as usize / cols.max(1) == rows - 1)
 }
 
-/// Moves row `k` of `v` (rows of `cols`) to row `new_row[k]`, in place (cycle by cycle, one row
-/// held aside).
-fn permute_rows<T: Copy>(v: &mut [T], cols: usize, new_row: &[usize]) {
+/// Moves row `k` of `v` (rows of `cols`) to row `new_row[k]`, in place: nothing where every row
+/// holds the same values (fields a file does not have: the reader's defaults), swaps of row pairs
+/// for a reversal (a top-first file), else cycle by cycle with one row held aside.
+fn permute_rows<T: Copy + PartialEq>(v: &mut [T], cols: usize, new_row: &[usize]) {
     let rows = new_row.len();
+    if new_row.iter().enumerate().all(|(k, &d)| d == k) {
+        return;
+    }
+    let first = &v[..cols];
+    if v[cols..].chunks_exact(cols).all(|row| row == first) {
+        return;
+    }
+    if new_row.iter().enumerate().all(|(k, &d)| d == rows - 1 - k) {
+        let (top, bottom) = v.split_at_mut(rows / 2 * cols);
+        let bottom = &mut bottom[(rows % 2) * cols..];
+        for (a, b) in top.chunks_exact_mut(cols).zip(bottom.chunks_exact_mut(cols).rev()) {
+            a.swap_with_slice(b);
+        }
+        return;
+    }
     let mut done = vec![false; rows];
     for start in 0..rows {
         if done[start] {
@@ -176,5 +193,30 @@ fn permute_rows<T: Copy>(v: &mut [T], cols: usize, new_row: &[usize]) {
             }
             k = d;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_move_to_their_new_rows() {
+        let (rows, cols) = (5, 3);
+        let v: Vec<u32> = (0..(rows * cols) as u32).collect();
+        for new_row in [vec![4, 3, 2, 1, 0], vec![1, 2, 0, 4, 3], vec![0, 1, 2, 3, 4]] {
+            let mut w = v.clone();
+            permute_rows(&mut w, cols, &new_row);
+            for (k, &d) in new_row.iter().enumerate() {
+                assert_eq!(&w[d * cols..(d + 1) * cols], &v[k * cols..(k + 1) * cols], "{new_row:?}");
+            }
+        }
+        // An even row count reversed, and rows that all hold the same values (left as they are).
+        let mut even: Vec<u32> = (0..8).collect();
+        permute_rows(&mut even, 2, &[3, 2, 1, 0]);
+        assert_eq!(even, [6, 7, 4, 5, 2, 3, 0, 1]);
+        let mut same = vec![7u8, 9, 7, 9, 7, 9];
+        permute_rows(&mut same, 2, &[2, 1, 0]);
+        assert_eq!(same, [7, 9, 7, 9, 7, 9]);
     }
 }

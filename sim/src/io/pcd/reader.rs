@@ -144,9 +144,11 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
     let has_range = pos(Slot::Range).is_some();
     for b0 in (0..n).step_by(BLOCK) {
         let b = b0..(b0 + BLOCK).min(n);
-        field(&src, pos(Slot::X), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.x = v as f32);
-        field(&src, pos(Slot::Y), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.y = v as f32);
-        field(&src, pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.z = v as f32);
+        if !src.f32_triple(pos(Slot::X), pos(Slot::Y), pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()]) {
+            field(&src, pos(Slot::X), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.x = v as f32);
+            field(&src, pos(Slot::Y), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.y = v as f32);
+            field(&src, pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.z = v as f32);
+        }
         for (p, r) in point_in_vehicle[b.clone()].iter_mut().zip(&mut range_m[b.clone()]) {
             // Drivers that keep no-return cells as zeros (ouster-ros, older velodyne): no return.
             let zero = *p == Vec3::ZERO;
@@ -162,13 +164,22 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
                 *r = if mm { (v * 1e-3) as f32 } else { v as f32 };
             }
         });
-        field(&src, pos(Slot::Intensity), b.clone(), &mut intensity[b.clone()], |o, v| *o = v as f32);
-        field(&src, pos(Slot::Ring), b.clone(), &mut ring[b.clone()], |o, v| *o = v as u16);
+        // Typed reads where the file's type is the common one (the same values as through `f64`).
+        if !src.direct::<_, f32>(pos(Slot::Intensity), Scalar::F(4), b.clone(), &mut intensity[b.clone()], |o, v| *o = v) {
+            field(&src, pos(Slot::Intensity), b.clone(), &mut intensity[b.clone()], |o, v| *o = v as f32);
+        }
+        if !src.direct::<_, u16>(pos(Slot::Ring), Scalar::U(2), b.clone(), &mut ring[b.clone()], |o, v| *o = v) {
+            field(&src, pos(Slot::Ring), b.clone(), &mut ring[b.clone()], |o, v| *o = v as u16);
+        }
         field(&src, pos(Slot::Column), b.clone(), &mut column[b.clone()], |o, v| *o = v as u32);
         field(&src, pos(Slot::Sensor), b.clone(), &mut sensor[b.clone()], |o, v| *o = v as u8);
         field(&src, pos(Slot::Time), b.clone(), &mut time_s[b.clone()], |o, v| *o = if ns { v * 1e-9 } else { v });
         field(&src, pos(Slot::Echo), b.clone(), &mut echo[b.clone()], |o, v| *o = v as u8);
-        field(&src, pos(Slot::Label), b.clone(), &mut label[b.clone()], |o, v| *o = SemanticClass(v as u16));
+        // A label above 65535 saturates, as the `f64` cast below does.
+        let label_u32 = |o: &mut SemanticClass, v: u32| *o = SemanticClass(u16::try_from(v).unwrap_or(u16::MAX));
+        if !src.direct::<_, u32>(pos(Slot::Label), Scalar::U(4), b.clone(), &mut label[b.clone()], label_u32) {
+            field(&src, pos(Slot::Label), b.clone(), &mut label[b.clone()], |o, v| *o = SemanticClass(v as u16));
+        }
         field(&src, pos(Slot::Instance), b.clone(), &mut instance[b.clone()], |o, v| *o = v as u32);
         for ((g, p), l) in ground[b.clone()].iter_mut().zip(&point_in_vehicle[b.clone()]).zip(&label[b.clone()]) {
             *g = !p.x.is_nan() & l.is_ground();
@@ -217,7 +228,84 @@ enum Source<'a> {
     Ascii { values: Vec<f64>, tokens: usize },
 }
 
+/// A little-endian scalar read straight from a record.
+trait FromLe: Sized {
+    /// Its size in bytes.
+    const SIZE: usize;
+    /// The value at the start of `b` (`SIZE` bytes or more).
+    fn from_le(b: &[u8]) -> Self;
+}
+
+impl FromLe for f32 {
+    const SIZE: usize = 4;
+    #[inline(always)]
+    fn from_le(b: &[u8]) -> Self {
+        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    }
+}
+
+impl FromLe for u32 {
+    const SIZE: usize = 4;
+    #[inline(always)]
+    fn from_le(b: &[u8]) -> Self {
+        u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    }
+}
+
+impl FromLe for u16 {
+    const SIZE: usize = 2;
+    #[inline(always)]
+    fn from_le(b: &[u8]) -> Self {
+        u16::from_le_bytes([b[0], b[1]])
+    }
+}
+
 impl Source<'_> {
+    /// Calls `set(&mut out[i], value)` for the field at `p` of every point of `points`, the value
+    /// read as `V`, where the field is binary of type `want` (true); else does nothing (false).
+    #[inline(always)]
+    fn direct<T, V: FromLe>(
+        &self,
+        p: Option<FieldPos>,
+        want: Scalar,
+        points: std::ops::Range<usize>,
+        out: &mut [T],
+        mut set: impl FnMut(&mut T, V),
+    ) -> bool {
+        let (Source::Binary { body, record }, Some(p)) = (self, p) else { return false };
+        if p.scalar != want || want.size() != V::SIZE || p.offset + V::SIZE > *record {
+            return false;
+        }
+        let recs = body[points.start * record..points.end * record].chunks_exact(*record);
+        for (r, o) in recs.zip(out) {
+            set(o, V::from_le(&r[p.offset..]));
+        }
+        true
+    }
+
+    /// The points of `points` from three `float32` fields `x`, `y`, `z` of binary records, read
+    /// together (one pass over the records instead of three); false where the fields are not all
+    /// binary `float32` (then nothing is written).
+    #[inline(always)]
+    fn f32_triple(
+        &self,
+        x: Option<FieldPos>,
+        y: Option<FieldPos>,
+        z: Option<FieldPos>,
+        points: std::ops::Range<usize>,
+        out: &mut [Vec3],
+    ) -> bool {
+        let (Source::Binary { body, record }, Some(x), Some(y), Some(z)) = (self, x, y, z) else { return false };
+        if [x, y, z].iter().any(|p| p.scalar != Scalar::F(4) || p.offset + 4 > *record) {
+            return false;
+        }
+        let f = |r: &[u8], at: usize| f32::from_le(&r[at..at + 4]);
+        for (r, o) in body[points.start * record..points.end * record].chunks_exact(*record).zip(out) {
+            *o = Vec3::new(f(r, x.offset), f(r, y.offset), f(r, z.offset));
+        }
+        true
+    }
+
     /// Calls `set(&mut out[i], value)` for the field at `p` of every point of `points` (`out` holds
     /// their slots, in order); the field's type is matched once, outside the loop, and records and
     /// slots are zipped (no index checks).
