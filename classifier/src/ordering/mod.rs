@@ -47,6 +47,11 @@ use usable::Usable;
 
 use crate::error::{ClassifyError, Result};
 
+thread_local! { pub static PROBE: std::cell::RefCell<[f64; 12]> = const { std::cell::RefCell::new([0.0; 12]) }; }
+/// probe
+pub fn probe_add(k: usize, t: std::time::Instant) { PROBE.with(|p| p.borrow_mut()[k] += t.elapsed().as_secs_f64()); }
+
+
 /// Largest fraction of bad points (NaN or infinite coordinates) a cloud may hold; they are
 /// skipped and counted. A cloud with more is refused.
 pub const MAX_BAD_FRACTION: f64 = 0.01;
@@ -74,6 +79,7 @@ pub fn order_cloud(
     choice: PathChoice,
     params: &UnfoldParams,
 ) -> Result<(OrderedCloud, OrderingReport)> {
+    let t0 = std::time::Instant::now();
     let rows = table.rows()?;
     let n = points_in_sensor.len();
     for (name, len) in [
@@ -88,6 +94,7 @@ pub fn order_cloud(
     }
     let mut report = OrderingReport { cell_of_point: vec![None; n], ..OrderingReport::default() };
     let usable = Usable::find(points_in_sensor, &mut report)?;
+    probe_add(0, t0); let t0 = std::time::Instant::now();
     let wishes = match (attributes.rings, choice) {
         (Some(rings), _) => {
             report.path = OrderingPath::RingField;
@@ -104,6 +111,7 @@ pub fn order_cloud(
                     match unfolded {
                         Unfolded::Wishes(wishes) => wishes,
                         Unfolded::Rings { bounds, row_of_ring, column, spans_turn } => {
+                            probe_add(1, t0); let t0 = std::time::Instant::now();
                             let (cells, planes) = placement::place_rings(
                                 &bounds,
                                 &row_of_ring,
@@ -113,6 +121,7 @@ pub fn order_cloud(
                                 rows.cols,
                                 &mut report,
                             );
+                            probe_add(2, t0); let t0 = std::time::Instant::now();
                             let cloud = placement::build_cloud(
                                 points_in_sensor,
                                 attributes,
@@ -124,6 +133,7 @@ pub fn order_cloud(
                                 vehicle_from_sensor,
                                 &mut report,
                             );
+                            probe_add(3, t0);
                             return Ok((cloud, report));
                         }
                     }

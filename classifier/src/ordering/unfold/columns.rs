@@ -66,6 +66,7 @@ pub(crate) fn column_steps(rows: &TableRows, row: usize, az: &[f32], dist: &[f32
 pub(crate) struct ColumnScratch {
     steps: Vec<f32>,
     unwrapped: Vec<f32>,
+    moved: Vec<i32>,
 }
 
 /// The whole columns (in `[0, cols)`) of one ring's points in a full-turn grid, from their
@@ -81,7 +82,7 @@ pub(crate) fn ring_columns(
     scratch: &mut ColumnScratch,
     out: &mut [u32],
 ) -> bool {
-    let ColumnScratch { steps, unwrapped } = scratch;
+    let ColumnScratch { steps, unwrapped, .. } = scratch;
     column_steps(rows, row, az, dist, steps);
     let (cols, col_dir) = (rows.cols as f32, -dir);
     // Progress in the scan direction, in columns: the increments as one pass, the sum in point
@@ -93,31 +94,50 @@ pub(crate) fn ring_columns(
             (wrap_once((pair[1] - pair[0]) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS) * col_dir
         }),
     );
-    let mut u = 0.0f32;
-    let mut largest = 0.0f32;
-    for (k, x) in unwrapped.iter_mut().enumerate() {
-        u = if k == 0 { *x } else { u + *x };
+    let mut u = unwrapped[0];
+    for x in &mut unwrapped[1..] {
+        u += *x;
         *x = u;
-        largest = largest.max(u.abs());
     }
+    // Columns beyond the integers that `f32` holds exactly (NaN included) take the float rule.
+    let exact = unwrapped.iter().fold(true, |ok, &u| ok & (u.abs() < EXACT_COLUMNS));
     round_all(unwrapped);
-    if largest >= EXACT_COLUMNS {
+    if !exact {
         return columns_by_float_rule(unwrapped, rows.cols, col_dir, out);
     }
     // The rule `c' = c` unless `(c - last) * col_dir < 1`, then `last + col_dir`, on whole
     // numbers: a running maximum (scan going up the columns) or minimum.
+    // The running maximum (or minimum) alone is serial; the wrap into `[0, cols)` is a second pass
+    // that vectorizes: a whole number of turns off the first column, then a turn either way at
+    // most (a remainder for the rare ring that strays further).
     let cols_i = rows.cols as i32;
     let first = unwrapped[0] as i32;
     let mut last = first - col_dir as i32;
+    let moved = &mut scratch.moved;
+    moved.clear();
     if col_dir > 0.0 {
-        for (o, &c) in out.iter_mut().zip(unwrapped.iter()) {
+        moved.extend(unwrapped.iter().map(|&c| {
             last = (c as i32).max(last + 1);
-            *o = last.rem_euclid(cols_i) as u32;
-        }
+            last
+        }));
     } else {
-        for (o, &c) in out.iter_mut().zip(unwrapped.iter()) {
+        moved.extend(unwrapped.iter().map(|&c| {
             last = (c as i32).min(last - 1);
-            *o = last.rem_euclid(cols_i) as u32;
+            last
+        }));
+    }
+    let base = first - first.rem_euclid(cols_i);
+    let mut strays = 0u32;
+    for (o, &c) in out.iter_mut().zip(moved.iter()) {
+        let w = c - base;
+        let w = if w >= cols_i { w - cols_i } else { w };
+        let w = if w < 0 { w + cols_i } else { w };
+        strays += u32::from(!(0..cols_i).contains(&w));
+        *o = w as u32;
+    }
+    if strays > 0 {
+        for (o, &c) in out.iter_mut().zip(moved.iter()) {
+            *o = c.rem_euclid(cols_i) as u32;
         }
     }
     (last - first).abs() >= cols_i
