@@ -93,16 +93,18 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
     let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut per_file = Vec::new();
     let mut all_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
+    // One reader for every file and repeat, as `classify` reads a sequence: buffers are reused.
+    let mut reader = super::classify::FrameReader::default();
     for (index, path) in files.iter().enumerate() {
         let (mut read, mut order, mut cls, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut file_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
         let mut last = None;
         for _ in 0..repeats {
             let t0 = Instant::now();
-            let (frame, read_ms) = super::classify::read_frame_timed(path, &setup)?;
+            let read_ms = reader.read(path, &setup)?;
             let t2 = Instant::now();
-            let out = method.classify(&FrameInput { index, cloud: &frame.cloud, world_from_vehicle: None })?;
-            let bytes = match &frame.report {
+            let out = method.classify(&FrameInput { index, cloud: reader.cloud(), world_from_vehicle: None })?;
+            let bytes = match reader.report() {
                 Some(r) => classifier::ordering::decisions_per_point(r, &out),
                 None => out.iter().map(|&g| u8::from(g)).collect(),
             };
@@ -116,17 +118,18 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
             }
             read.push(read_ms);
             order.push((t2 - t0).as_secs_f64() * 1e3 - read_ms);
-            last = Some((frame, bytes.iter().filter(|&&b| b == 1).count(), bytes.len()));
+            last = Some((bytes.iter().filter(|&&b| b == 1).count(), bytes.len()));
         }
-        let (frame, ground, points) = last.expect("one repeat");
+        let (ground, points) = last.expect("one repeat");
+        let frame = &reader;
         let mut entry = serde_json::json!({
             "file": path.display().to_string(),
             "points": points,
             "ground": ground,
-            "rows": frame.cloud.rows,
-            "cols": frame.cloud.cols,
-            "planes": frame.cloud.planes,
-            "ordering": frame.report.as_ref().map(|r| serde_json::to_value(r).unwrap_or_default()),
+            "rows": frame.cloud().rows,
+            "cols": frame.cloud().cols,
+            "planes": frame.cloud().planes,
+            "ordering": frame.report().map(|r| serde_json::to_value(r).unwrap_or_default()),
             "read_ms": stats(&read),
             "order_ms": stats(&order),
             "classify_ms": stats(&cls),

@@ -10,8 +10,8 @@
 pub mod cluster;
 pub mod features;
 pub mod neighbours;
-mod row_returns;
 pub mod row_order;
+mod row_returns;
 
 use glam::Vec3;
 

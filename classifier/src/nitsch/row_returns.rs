@@ -52,7 +52,11 @@ impl RowReturns {
         self.right.resize(n, 0);
         self.left.resize(n, 0);
         self.near.resize(n, FAR);
-        let tables = self.right.chunks_exact_mut(cols).zip(self.left.chunks_exact_mut(cols)).zip(self.near.chunks_exact_mut(cols));
+        let tables = self
+            .right
+            .chunks_exact_mut(cols)
+            .zip(self.left.chunks_exact_mut(cols))
+            .zip(self.near.chunks_exact_mut(cols));
         for (v, ((right, left), near)) in valid[..n].chunks_exact(cols).zip(tables) {
             if gap <= SHIFTED_GAP {
                 shifted(v, gap, right, left);
@@ -64,7 +68,13 @@ impl RowReturns {
             }
             for (c, ((&r, &l), o)) in right.iter().zip(left.iter()).zip(near.iter_mut()).enumerate() {
                 // Itself, else the nearer side (the right on a tie).
-                let side = if r != 0 && (l == 0 || r <= l) { r as i8 } else if l != 0 { -(l as i8) } else { FAR };
+                let side = if r != 0 && (l == 0 || r <= l) {
+                    r as i8
+                } else if l != 0 {
+                    -(l as i8)
+                } else {
+                    FAR
+                };
                 *o = if v[c] { 0 } else { side };
             }
         }

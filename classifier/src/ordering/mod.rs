@@ -38,7 +38,7 @@ use sim::{OrderedCloud, SemanticClass};
 
 pub use beam_table::{BeamTable, TableRows};
 pub use calibration::{Calibration, CalibrationError};
-pub use organized::order_organized;
+pub use organized::{order_organized, order_organized_in_place};
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};
 pub use unfold::UnfoldParams;
@@ -46,11 +46,6 @@ use unfold::Unfolded;
 use usable::Usable;
 
 use crate::error::{ClassifyError, Result};
-
-thread_local! { pub static PROBE: std::cell::RefCell<[f64; 12]> = const { std::cell::RefCell::new([0.0; 12]) }; }
-/// probe
-pub fn probe_add(k: usize, t: std::time::Instant) { PROBE.with(|p| p.borrow_mut()[k] += t.elapsed().as_secs_f64()); }
-
 
 /// Largest fraction of bad points (NaN or infinite coordinates) a cloud may hold; they are
 /// skipped and counted. A cloud with more is refused.
@@ -79,7 +74,34 @@ pub fn order_cloud(
     choice: PathChoice,
     params: &UnfoldParams,
 ) -> Result<(OrderedCloud, OrderingReport)> {
-    let t0 = std::time::Instant::now();
+    let (mut cloud, mut report) = (OrderedCloud::default(), OrderingReport::default());
+    order_cloud_into(
+        points_in_sensor,
+        attributes,
+        table,
+        vehicle_from_sensor,
+        choice,
+        params,
+        &mut cloud,
+        &mut report,
+    )?;
+    Ok((cloud, report))
+}
+
+/// As [`order_cloud`], into `cloud` and `report`, whose buffers are reused: a sequence of frames
+/// ordered one after another allocates no cloud once they are large enough. On an error their
+/// content is not meaningful.
+#[allow(clippy::too_many_arguments)]
+pub fn order_cloud_into(
+    points_in_sensor: &[Vec3],
+    attributes: &PointAttributes<'_>,
+    table: &BeamTable,
+    vehicle_from_sensor: Affine3A,
+    choice: PathChoice,
+    params: &UnfoldParams,
+    cloud: &mut OrderedCloud,
+    report: &mut OrderingReport,
+) -> Result<()> {
     let rows = table.rows()?;
     let n = points_in_sensor.len();
     for (name, len) in [
@@ -92,26 +114,27 @@ pub fn order_cloud(
             return Err(ClassifyError::Ordering(format!("{name} and points differ in length")));
         }
     }
-    let mut report = OrderingReport { cell_of_point: vec![None; n], ..OrderingReport::default() };
-    let usable = Usable::find(points_in_sensor, &mut report)?;
-    probe_add(0, t0); let t0 = std::time::Instant::now();
+    let mut cell_of_point = std::mem::take(&mut report.cell_of_point);
+    cell_of_point.clear();
+    cell_of_point.resize(n, None);
+    *report = OrderingReport { cell_of_point, ..OrderingReport::default() };
+    let usable = Usable::find(points_in_sensor, report)?;
     let wishes = match (attributes.rings, choice) {
         (Some(rings), _) => {
             report.path = OrderingPath::RingField;
-            table::ring_wishes(points_in_sensor, &usable, rings, &rows, &mut report).map_err(ClassifyError::Ordering)?
+            table::ring_wishes(points_in_sensor, &usable, rings, &rows, report).map_err(ClassifyError::Ordering)?
         }
         (None, PathChoice::BeamTable) => {
             report.path = OrderingPath::BeamTable;
-            table::table_wishes(points_in_sensor, &usable, &rows, &mut report)
+            table::table_wishes(points_in_sensor, &usable, &rows, report)
         }
         (None, PathChoice::Unfold | PathChoice::Auto) => {
-            match unfold::unfold(points_in_sensor, &usable, &rows, params, &mut report) {
+            match unfold::unfold(points_in_sensor, &usable, &rows, params, report) {
                 Ok(unfolded) => {
                     report.path = OrderingPath::Unfolded;
                     match unfolded {
                         Unfolded::Wishes(wishes) => wishes,
                         Unfolded::Rings { bounds, row_of_ring, column, spans_turn } => {
-                            probe_add(1, t0); let t0 = std::time::Instant::now();
                             let (cells, planes) = placement::place_rings(
                                 &bounds,
                                 &row_of_ring,
@@ -119,10 +142,9 @@ pub fn order_cloud(
                                 &spans_turn,
                                 rows.len(),
                                 rows.cols,
-                                &mut report,
+                                report,
                             );
-                            probe_add(2, t0); let t0 = std::time::Instant::now();
-                            let cloud = placement::build_cloud(
+                            placement::build_cloud(
                                 points_in_sensor,
                                 attributes,
                                 &usable,
@@ -131,10 +153,10 @@ pub fn order_cloud(
                                 rows.cols,
                                 planes,
                                 vehicle_from_sensor,
-                                &mut report,
+                                cloud,
+                                report,
                             );
-                            probe_add(3, t0);
-                            return Ok((cloud, report));
+                            return Ok(());
                         }
                     }
                 }
@@ -142,14 +164,14 @@ pub fn order_cloud(
                     report.path = OrderingPath::BeamTable;
                     report.fallback = Some(why);
                     report.rings_found = 0;
-                    table::table_wishes(points_in_sensor, &usable, &rows, &mut report)
+                    table::table_wishes(points_in_sensor, &usable, &rows, report)
                 }
                 Err(why) => return Err(ClassifyError::Ordering(format!("the points do not unfold: {why}"))),
             }
         }
     };
-    let (cells, planes) = placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, &mut report);
-    let cloud = placement::build_cloud(
+    let (cells, planes) = placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, report);
+    placement::build_cloud(
         points_in_sensor,
         attributes,
         &usable,
@@ -158,9 +180,10 @@ pub fn order_cloud(
         rows.cols,
         planes,
         vehicle_from_sensor,
-        &mut report,
+        cloud,
+        report,
     );
-    Ok((cloud, report))
+    Ok(())
 }
 
 /// Orders `points_in_sensor` (with optional labels) by the beam table alone, ignoring their order

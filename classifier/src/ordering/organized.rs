@@ -34,11 +34,24 @@ pub const SAME_SURFACE: f32 = 0.2;
 /// normals) go to the vehicle frame through `vehicle_from_sensor`; ranges stay the file's (or the
 /// distance from the file's origin where it has none).
 pub fn order_organized(
-    cloud: OrderedCloud,
+    mut cloud: OrderedCloud,
     has_ring: bool,
     vehicle_from_sensor: glam::Affine3A,
 ) -> Result<(OrderedCloud, OrderingReport)> {
-    crate::error::check_cloud(&cloud)?;
+    let mut report = OrderingReport::default();
+    order_organized_in_place(&mut cloud, has_ring, vehicle_from_sensor, &mut report)?;
+    Ok((cloud, report))
+}
+
+/// As [`order_organized`], in place, with the report into `report` (whose buffer is reused). On an
+/// error the cloud is unchanged.
+pub fn order_organized_in_place(
+    cloud: &mut OrderedCloud,
+    has_ring: bool,
+    vehicle_from_sensor: glam::Affine3A,
+    report: &mut OrderingReport,
+) -> Result<()> {
+    crate::error::check_cloud(cloud)?;
     let (rows, cols) = (cloud.rows, cloud.cols);
     if cloud.planes != 1 {
         return Err(ClassifyError::Ordering(format!(
@@ -119,7 +132,7 @@ pub fn order_organized(
         )));
     };
     let new_row: Vec<usize> = ring_of_row.iter().map(|&g| if bottom_first { g } else { rows - 1 - g }).collect();
-    let mut out = cloud;
+    let out = cloud;
     macro_rules! permute {
         ($($f:ident),*) => {$( permute_rows(&mut out.$f, cols, &new_row); )*};
     }
@@ -133,11 +146,9 @@ pub fn order_organized(
             }
         }
     }
-    let mut report = OrderingReport {
-        path: OrderingPath::Organized,
-        cell_of_point: Vec::with_capacity(rows * cols),
-        ..OrderingReport::default()
-    };
+    let mut cell_of_point = std::mem::take(&mut report.cell_of_point);
+    cell_of_point.clear();
+    *report = OrderingReport { path: OrderingPath::Organized, cell_of_point, ..OrderingReport::default() };
     for &r in &new_row {
         // A range of known length: `extend` writes it without a capacity check per cell.
         report.cell_of_point.extend((r * cols..(r + 1) * cols).map(|i| Some(i as u32)));
@@ -145,7 +156,7 @@ pub fn order_organized(
     report.placed = out.returns();
     report.no_returns = rows * cols - report.placed;
     report.rings_found = rings_with_returns;
-    Ok((out, report))
+    Ok(())
 }
 
 /// Whether [`order_organized`] found the file top-first: its first row went to the top.

@@ -256,7 +256,7 @@ impl Stacked {
     }
 }
 
-/// Builds the cloud: the usable points in their cells (`cell_of_usable`), moved to the vehicle
+/// Builds the cloud into `cloud` (its buffers reused): the usable points in their cells (`cell_of_usable`), moved to the vehicle
 /// frame by `vehicle_from_sensor`; every cell's `ring` is its row and `column` its column.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn build_cloud(
@@ -268,28 +268,10 @@ pub(crate) fn build_cloud(
     cols: usize,
     planes: usize,
     vehicle_from_sensor: Affine3A,
+    cloud: &mut OrderedCloud,
     report: &mut OrderingReport,
-) -> OrderedCloud {
-    // Built here rather than by `OrderedCloud::empty` (whose rayon fill costs more than it saves on
-    // one core for a frame of this size).
-    let n = rows * cols * planes;
-    let mut cloud = OrderedCloud {
-        rows,
-        cols,
-        planes,
-        point_in_vehicle: vec![Vec3::NAN; n],
-        range_m: vec![f32::NAN; n],
-        intensity: vec![0.0; n],
-        ring: vec![0; n],
-        column: vec![0; n],
-        sensor: vec![u8::MAX; n],
-        time_s: vec![0.0; n],
-        echo: vec![0; n],
-        label: vec![SemanticClass::UNLABELED; n],
-        instance: vec![0; n],
-        ground: vec![false; n],
-        normal: vec![Vec3::ZERO; n],
-    };
+) {
+    cloud.reset(rows, cols, planes);
     for (ring_index, (ring, column)) in
         cloud.ring.chunks_exact_mut(cols).zip(cloud.column.chunks_exact_mut(cols)).enumerate()
     {
@@ -306,15 +288,14 @@ pub(crate) fn build_cloud(
     // first one's values are written last and stay (a shared cell keeps its first point).
     let transform = (vehicle_from_sensor != Affine3A::IDENTITY).then_some(vehicle_from_sensor);
     match usable.indices() {
-        None => scatter(&mut cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| i),
-        Some(idx) => scatter(&mut cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| idx[i] as usize),
+        None => scatter(cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| i),
+        Some(idx) => scatter(cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| idx[i] as usize),
     }
     if planes > 1 {
         for &cell in cell_of_usable {
             cloud.echo[cell as usize] = (cell as usize / plane) as u8;
         }
     }
-    cloud
 }
 
 /// Writes the points (usable point `i` is input point `point(i)`, its cell `cells[i]`) and their

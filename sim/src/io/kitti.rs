@@ -134,20 +134,41 @@ pub fn read_points(bin: &Path, label: Option<&Path>) -> Result<KittiPoints> {
 
 /// Parses KITTI `.bin` bytes into [`KittiPoints`] (lengths checked as in [`read_bytes`]).
 pub fn points_from_bytes(bin_path: &Path, bin: &[u8], label: Option<(&Path, &[u8])>) -> Result<KittiPoints> {
+    let mut out = KittiPoints::default();
+    points_from_bytes_into(bin_path, bin, label, &mut out)?;
+    Ok(out)
+}
+
+/// As [`points_from_bytes`], into `out`, whose buffers are reused (frames read one after another
+/// allocate nothing once they are large enough).
+pub fn points_from_bytes_into(
+    bin_path: &Path,
+    bin: &[u8],
+    label: Option<(&Path, &[u8])>,
+    out: &mut KittiPoints,
+) -> Result<()> {
     let n = check_lengths(bin_path, bin, label)?;
     let f = |b: &[u8], k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
-    let mut points = Vec::with_capacity(n);
-    let mut intensity = Vec::with_capacity(n);
+    out.points.clear();
+    out.intensity.clear();
+    out.points.reserve(n);
+    out.intensity.reserve(n);
     for rec in bin.chunks_exact(16) {
-        points.push(Vec3::new(f(rec, 0), f(rec, 4), f(rec, 8)));
-        intensity.push(f(rec, 12));
+        out.points.push(Vec3::new(f(rec, 0), f(rec, 4), f(rec, 8)));
+        out.intensity.push(f(rec, 12));
     }
-    let labels = label.map(|(_, lb)| {
-        lb.chunks_exact(4)
-            .map(|c| SemanticClass((u32::from_le_bytes([c[0], c[1], c[2], c[3]]) & 0xFFFF) as u16))
-            .collect()
-    });
-    Ok(KittiPoints { points, intensity, labels })
+    match label {
+        Some((_, lb)) => {
+            let labels = out.labels.get_or_insert_with(Vec::new);
+            labels.clear();
+            labels.extend(
+                lb.chunks_exact(4)
+                    .map(|c| SemanticClass((u32::from_le_bytes([c[0], c[1], c[2], c[3]]) & 0xFFFF) as u16)),
+            );
+        }
+        None => out.labels = None,
+    }
+    Ok(())
 }
 
 /// Checks that `bin` holds whole 16-byte records and `label` one uint32 per record; the record count.

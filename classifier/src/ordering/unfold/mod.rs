@@ -164,9 +164,7 @@ pub(crate) fn unfold(
     params: &UnfoldParams,
     report: &mut OrderingReport,
 ) -> Result<Unfolded, String> {
-    let t0 = std::time::Instant::now();
     let (az, dist, mut fine) = super::polar::polar(points, usable.indices());
-    super::probe_add(4, t0); let t0 = std::time::Instant::now();
     if rows.horizontal_m.iter().chain(&rows.vertical_m).any(|&x| x != 0.0) {
         // With origin offsets, the elevation seen from the nearest beam's origin; without them the
         // elevation seen from the sensor origin is exact enough.
@@ -174,12 +172,10 @@ pub(crate) fn unfold(
     }
     let (mut bounds, dir) = ring_starts(&az, &dist, &fine, rows, params)?;
     bounds.push(usable.len());
-    super::probe_add(5, t0); let t0 = std::time::Instant::now();
     // The rings' medians, selected in place (the elevations are not needed after this).
     let medians: Vec<f32> = bounds.windows(2).map(|w| median(&mut fine[w[0]..w[1]])).collect();
     let row_of_ring = match_rows(&medians, rows, params)?;
     report.rings_found = bounds.len() - 1;
-    super::probe_add(6, t0); let t0 = std::time::Instant::now();
     if !rows.full_turn {
         let mut wishes = Vec::with_capacity(usable.len());
         let mut steps = Vec::new();
@@ -199,6 +195,5 @@ pub(crate) fn unfold(
             columns::ring_columns(rows, row, az, dist, dir, &mut scratch, &mut column[w[0]..w[1]])
         })
         .collect();
-    super::probe_add(7, t0);
     Ok(Unfolded::Rings { bounds, row_of_ring, column, spans_turn })
 }

@@ -29,5 +29,5 @@ mod reader;
 mod writer;
 
 pub use layouts::{PcdLayout, encode_layout, write_layout};
-pub use reader::{PcdInfo, read, read_bytes, read_bytes_with_info, read_with_info};
+pub use reader::{PcdInfo, read, read_bytes, read_bytes_into, read_bytes_with_info, read_with_info};
 pub use writer::{RECORD_BYTES, encode, write};

@@ -48,6 +48,15 @@ pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
 
 /// As [`read_bytes`], also saying which conventions the file follows.
 pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, PcdInfo)> {
+    let mut cloud = OrderedCloud::default();
+    let info = read_bytes_into(path, bytes, &mut cloud)?;
+    Ok((cloud, info))
+}
+
+/// As [`read_bytes_with_info`], into `cloud`, whose buffers are reused (a sequence of frames
+/// read one after another allocates nothing once they are large enough). On an error `cloud`
+/// holds no meaningful content.
+pub fn read_bytes_into(path: &Path, bytes: &[u8], cloud: &mut OrderedCloud) -> Result<PcdInfo> {
     let h = parse_header(path, bytes)?;
     let integer = |s: Slot| h.slots[s as usize].is_some_and(|p| !matches!(p.scalar, Scalar::F(_)));
     let mut info = PcdInfo {
@@ -118,26 +127,32 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
     // loops per field streamed the records from memory once per field.
     let pos = |s: Slot| h.slots[s as usize];
     let (rows1, cols1, plane1) = (rows.max(1), cols.max(1), (rows * cols).max(1));
-    let mut point_in_vehicle = vec![Vec3::NAN; n];
-    let mut range_m = vec![f32::NAN; n];
-    let mut intensity = vec![0.0f32; n];
+    cloud.reset(rows, cols, planes);
+    debug_assert_eq!(cloud.len(), n);
+    let OrderedCloud {
+        point_in_vehicle,
+        range_m,
+        intensity,
+        ring,
+        column,
+        sensor,
+        time_s,
+        echo,
+        label,
+        instance,
+        ground,
+        normal,
+        ..
+    } = cloud;
     // Defaults row by row (a division per point cost 1.5 ms a frame).
-    let mut ring = vec![0u16; n];
-    let mut column = vec![0u32; n];
     for (k, (rg, cl)) in ring.chunks_mut(cols1).zip(column.chunks_mut(cols1)).enumerate() {
         rg.fill((k % rows1) as u16);
         cl.iter_mut().enumerate().for_each(|(c, v)| *v = c as u32);
     }
-    let mut sensor = vec![0u8; n];
-    let mut time_s = vec![0.0f64; n];
-    let mut echo = vec![0u8; n];
+    sensor.fill(0);
     for (k, e) in echo.chunks_mut(plane1).enumerate() {
         e.fill(k as u8);
     }
-    let mut label = vec![SemanticClass(0); n];
-    let mut instance = vec![0u32; n];
-    let mut ground = vec![false; n];
-    let mut normal = vec![Vec3::ZERO; n];
     let (mm, ns) = (info.range_in_mm, info.time_in_ns);
     let normals = pos(Slot::Nx).is_some() && pos(Slot::Ny).is_some() && pos(Slot::Nz).is_some();
     // A file's own `range` field replaces the length below (a return's mark until then).
@@ -165,7 +180,9 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
             }
         });
         // Typed reads where the file's type is the common one (the same values as through `f64`).
-        if !src.direct::<_, f32>(pos(Slot::Intensity), Scalar::F(4), b.clone(), &mut intensity[b.clone()], |o, v| *o = v) {
+        if !src
+            .direct::<_, f32>(pos(Slot::Intensity), Scalar::F(4), b.clone(), &mut intensity[b.clone()], |o, v| *o = v)
+        {
             field(&src, pos(Slot::Intensity), b.clone(), &mut intensity[b.clone()], |o, v| *o = v as f32);
         }
         if !src.direct::<_, u16>(pos(Slot::Ring), Scalar::U(2), b.clone(), &mut ring[b.clone()], |o, v| *o = v) {
@@ -196,24 +213,7 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
             }
         }
     }
-    let cloud = OrderedCloud {
-        rows,
-        cols,
-        planes,
-        point_in_vehicle,
-        range_m,
-        intensity,
-        ring,
-        column,
-        sensor,
-        time_s,
-        echo,
-        label,
-        instance,
-        ground,
-        normal,
-    };
-    Ok((cloud, info))
+    Ok(info)
 }
 
 /// Points decoded together: a block's records (9 kB of a 36-byte ouster-ros record) stay in the
