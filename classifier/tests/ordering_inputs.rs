@@ -198,3 +198,43 @@ fn ring_fields_give_rows_top_first_or_bottom_first_and_out_of_range_rings_are_re
         .to_string();
     assert!(e.contains("ring 16, out of range"), "{e}");
 }
+
+/// A garage seen by a 16-beam sensor in its own frame: the lower beams hit the floor 1.8 m below,
+/// the upper ones a ceiling 0.6 m above, which the higher beams meet nearer (on the ceiling the
+/// step between neighbouring rings' points is inwards, against the ground's). The rows come out in
+/// elevation order whichever way up they are stored; the surface vote alone leaned neither way
+/// (a real `garage` scan in the velodyne layout was refused).
+#[test]
+fn rows_under_a_ceiling_are_put_in_elevation_order() {
+    let (rows, cols) = (16, 360);
+    let elevation = |g: usize| (-15.0 + 2.0 * g as f32).to_radians();
+    let mut bottom = sim::OrderedCloud::empty(rows, cols, 1);
+    for g in 0..rows {
+        for c in 0..cols {
+            let (e, az) = (elevation(g), std::f32::consts::PI - (c as f32 + 0.5) * std::f32::consts::TAU / cols as f32);
+            // Floor, ceiling, or (the flattest beams) a wall 12 m away.
+            let r = if e < -0.08 {
+                1.8 / (-e).sin()
+            } else if e > 0.06 {
+                (0.6 / e.sin()).min(12.0 / e.cos())
+            } else {
+                12.0 / e.cos()
+            };
+            let i = g * cols + c;
+            bottom.point_in_vehicle[i] = Vec3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin()) * r;
+            bottom.range_m[i] = r;
+            bottom.ring[i] = g as u16;
+        }
+    }
+    let mut top = bottom.clone();
+    for k in 0..rows {
+        let src = (rows - 1 - k) * cols;
+        top.point_in_vehicle[k * cols..(k + 1) * cols].copy_from_slice(&bottom.point_in_vehicle[src..src + cols]);
+        top.range_m[k * cols..(k + 1) * cols].copy_from_slice(&bottom.range_m[src..src + cols]);
+    }
+    for (stored, top_first) in [(&bottom, false), (&top, true)] {
+        let (ordered, report) = order_organized(stored.clone(), false, Affine3A::IDENTITY).unwrap();
+        assert_eq!(classifier::ordering::organized::is_top_first(&report, rows, cols), top_first);
+        assert_eq!(ordered.point_in_vehicle, bottom.point_in_vehicle, "stored top-first: {top_first}");
+    }
+}

@@ -84,8 +84,10 @@ impl OrderedCloud {
     /// ```
     /// let mut cloud = sim::OrderedCloud::empty(2, 3, 1);
     /// cloud.range_m[4] = 7.5;
+    /// cloud.sensor[4] = 0;
     /// cloud.reset(4, 3, 1);
-    /// assert_eq!(cloud, sim::OrderedCloud::empty(4, 3, 1));
+    /// assert_eq!((cloud.rows, cloud.len(), cloud.returns()), (4, 12, 0));
+    /// assert!(cloud.sensor.iter().all(|&s| s == u8::MAX));
     /// ```
     pub fn reset(&mut self, rows: usize, cols: usize, planes: usize) {
         fn refill<T: Clone>(v: &mut Vec<T>, value: T, n: usize) {

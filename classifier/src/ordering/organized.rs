@@ -4,13 +4,20 @@
 //!
 //! With a `ring` field, each file row must hold one ring value below the row count, every row a
 //! different one (else the file is refused, naming the value); without, the file row index stands
-//! for the ring. Which way the rings go is told from the data, in any frame whose z is up: in each
-//! column, two neighbouring rings' points that lie on one surface (closer than [`SAME_SURFACE`] of
-//! their horizontal distance `d`) step from the lower beam to the upper one outwards on the ground
-//! and upwards on a wall, so `dz + dd > 0`. Each such pair in every `cols / VOTING_COLUMNS`-th column
-//! votes; a balance
-//! `(up - down) / (up + down)` above [`MIN_DIRECTION_SCORE`] means ring 0 is the bottom beam, below
-//! its negative the top beam; in between the layout cannot be told and the cloud is refused with a
+//! for the ring. Which way the rings go is told from the data, by two votes over the pairs of
+//! neighbouring rings' points in every `cols / VOTING_COLUMNS`-th column:
+//! - **elevation**: seen from the file's origin (the sensor, in the drivers' layouts), the upper
+//!   beam's point lies higher, `z / d` larger (`d` the horizontal distance), on any surface;
+//! - **surface**: two points on one surface (closer than [`SAME_SURFACE`] of `d`) step from the
+//!   lower beam to the upper one outwards on the ground and upwards on a wall, `dz + dd > 0`, in any
+//!   frame whose z is up (also a file in a vehicle frame, whose origin lies below the sensor and
+//!   sees the ground at elevation 0); it fails under a ceiling (a garage), which the upper beam
+//!   meets nearer.
+//!
+//! Each vote's balance is `(up - down) / (up + down)`. The elevation vote decides where it leans
+//! beyond [`MIN_DIRECTION_SCORE`], else the surface vote where it does; above the threshold ring 0
+//! is the bottom beam, below its negative the top beam. Where neither is decisive, or the two lean
+//! beyond it in opposite directions, the layout cannot be told and the cloud is refused with a
 //! message, never guessed. Decisions come back in the input's own cell order through
 //! [`OrderingReport::cell_of_point`].
 
@@ -91,6 +98,7 @@ pub fn order_organized_in_place(
         row_of_ring[g] = k;
     }
     let (mut up, mut down, mut rings_with_returns) = (0usize, 0usize, 0usize);
+    let (mut higher, mut lower) = (0usize, 0usize);
     // Every `stride`-th column votes (at least `VOTING_COLUMNS` of them): tens of thousands of
     // votes decide as well as all 131,072 pairs of a 128 x 1024 frame, at an eighth of the cost.
     let stride = (cols / VOTING_COLUMNS).max(1);
@@ -107,6 +115,10 @@ pub fn order_organized_in_place(
                 continue;
             }
             let (dp, dq) = ((p.x * p.x + p.y * p.y).sqrt(), (q.x * q.x + q.y * q.y).sqrt());
+            // Elevation seen from the origin: `q.z / dq` against `p.z / dp`, without divisions.
+            let (eq, ep) = (q.z * dp, p.z * dq);
+            higher += usize::from(eq > ep);
+            lower += usize::from(eq < ep);
             if p.distance(q) > SAME_SURFACE * dp.min(dq) {
                 continue;
             }
@@ -121,15 +133,30 @@ pub fn order_organized_in_place(
     if rings_with_returns < 2 {
         return Err(ClassifyError::Ordering(format!("{rings_with_returns} rings hold returns: fewer than two")));
     }
-    let score = (up as f32 - down as f32) / (up + down).max(1) as f32;
-    let bottom_first = if score > MIN_DIRECTION_SCORE {
-        true
-    } else if score < -MIN_DIRECTION_SCORE {
-        false
-    } else {
-        return Err(ClassifyError::Ordering(format!(
-            "cannot tell which way up the rows are stored ({up} neighbouring pairs step up, {down} down; needs a balance beyond +-{MIN_DIRECTION_SCORE})"
-        )));
+    let balance = |up: usize, down: usize| (up as f32 - down as f32) / (up + down).max(1) as f32;
+    let (elevation, surface) = (balance(higher, lower), balance(up, down));
+    let lean = |score: f32| {
+        if score > MIN_DIRECTION_SCORE {
+            Some(true)
+        } else if score < -MIN_DIRECTION_SCORE {
+            Some(false)
+        } else {
+            None
+        }
+    };
+    let bottom_first = match (lean(elevation), lean(surface)) {
+        (Some(a), Some(b)) if a != b => {
+            return Err(ClassifyError::Ordering(format!(
+                "cannot tell which way up the rows are stored: seen from the file's origin the rings rise {} (balance {elevation:.2}), but neighbouring points on one surface step the other way (balance {surface:.2})",
+                if a { "upwards" } else { "downwards" }
+            )));
+        }
+        (Some(a), _) | (None, Some(a)) => a,
+        (None, None) => {
+            return Err(ClassifyError::Ordering(format!(
+                "cannot tell which way up the rows are stored ({higher} neighbouring pairs rise in elevation and {lower} fall, {up} step up on one surface and {down} down; needs a balance beyond +-{MIN_DIRECTION_SCORE})"
+            )));
+        }
     };
     let new_row: Vec<usize> = ring_of_row.iter().map(|&g| if bottom_first { g } else { rows - 1 - g }).collect();
     let out = cloud;
