@@ -119,58 +119,40 @@ pub fn order_cloud_into(
     cell_of_point.resize(n, None);
     *report = OrderingReport { cell_of_point, ..OrderingReport::default() };
     let usable = Usable::find(points_in_sensor, report)?;
-    let wishes = match (attributes.rings, choice) {
+    let place = |wishes: Vec<placement::Wish>, report: &mut OrderingReport| {
+        placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, report)
+    };
+    let (cells, planes) = match (attributes.rings, choice) {
         (Some(rings), _) => {
             report.path = OrderingPath::RingField;
-            table::ring_wishes(points_in_sensor, &usable, rings, &rows, report).map_err(ClassifyError::Ordering)?
+            let wishes =
+                table::ring_wishes(points_in_sensor, &usable, rings, &rows, report).map_err(ClassifyError::Ordering)?;
+            place(wishes, report)
         }
         (None, PathChoice::BeamTable) => {
             report.path = OrderingPath::BeamTable;
-            table::table_wishes(points_in_sensor, &usable, &rows, report)
+            place(table::table_wishes(points_in_sensor, &usable, &rows, report), report)
         }
         (None, PathChoice::Unfold | PathChoice::Auto) => {
             match unfold::unfold(points_in_sensor, &usable, &rows, params, report) {
-                Ok(unfolded) => {
+                Ok(Unfolded::Wishes(wishes)) => {
                     report.path = OrderingPath::Unfolded;
-                    match unfolded {
-                        Unfolded::Wishes(wishes) => wishes,
-                        Unfolded::Rings { bounds, row_of_ring, column, spans_turn } => {
-                            let (cells, planes) = placement::place_rings(
-                                &bounds,
-                                &row_of_ring,
-                                &column,
-                                &spans_turn,
-                                rows.len(),
-                                rows.cols,
-                                report,
-                            );
-                            placement::build_cloud(
-                                points_in_sensor,
-                                attributes,
-                                &usable,
-                                &cells,
-                                rows.len(),
-                                rows.cols,
-                                planes,
-                                vehicle_from_sensor,
-                                cloud,
-                                report,
-                            );
-                            return Ok(());
-                        }
-                    }
+                    place(wishes, report)
+                }
+                Ok(Unfolded::Rings { bounds, row_of_ring, column, spans_turn }) => {
+                    report.path = OrderingPath::Unfolded;
+                    placement::place_rings(&bounds, &row_of_ring, &column, &spans_turn, rows.len(), rows.cols, report)
                 }
                 Err(why) if choice == PathChoice::Auto => {
                     report.path = OrderingPath::BeamTable;
                     report.fallback = Some(why);
                     report.rings_found = 0;
-                    table::table_wishes(points_in_sensor, &usable, &rows, report)
+                    place(table::table_wishes(points_in_sensor, &usable, &rows, report), report)
                 }
                 Err(why) => return Err(ClassifyError::Ordering(format!("the points do not unfold: {why}"))),
             }
         }
     };
-    let (cells, planes) = placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, report);
     placement::build_cloud(
         points_in_sensor,
         attributes,
