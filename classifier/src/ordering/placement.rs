@@ -196,7 +196,7 @@ pub(crate) fn place_rings(
 /// [`NEAR_COLUMNS`] (wrapped over a full turn). The column found is taken for `w`.
 fn free_column_near(owner: &mut [u32], w: u32, c: usize, alt: Option<usize>, full_turn: bool) -> Option<usize> {
     let cols = owner.len();
-    let near = (2..=NEAR_COLUMNS as isize).flat_map(|k| [k, -k]).chain([-1, 1]).filter_map(|k| {
+    let mut near = (2..=NEAR_COLUMNS as isize).flat_map(|k| [k, -k]).chain([-1, 1]).filter_map(|k| {
         let c2 = c as isize + k;
         if full_turn {
             Some(c2.rem_euclid(cols as isize) as usize)
@@ -204,7 +204,7 @@ fn free_column_near(owner: &mut [u32], w: u32, c: usize, alt: Option<usize>, ful
             usize::try_from(c2).ok().filter(|&a| a < cols)
         }
     });
-    let free = alt.filter(|&a| owner[a] == FREE).or_else(|| near.into_iter().find(|&c2| owner[c2] == FREE))?;
+    let free = alt.filter(|&a| owner[a] == FREE).or_else(|| near.find(|&c2| owner[c2] == FREE))?;
     owner[free] = w;
     Some(free)
 }
