@@ -110,6 +110,27 @@ impl OrderedCloud {
         refill(&mut self.normal, Vec3::ZERO, n);
     }
 
+    /// Gives every field `planes * rows * cols` entries without setting them: the entries kept
+    /// from the previous frame hold its values, new ones the no-return values. For readers that
+    /// then write every entry of every field (a cloud refilled frame after frame writes each
+    /// entry once instead of twice).
+    pub(crate) fn reshape(&mut self, rows: usize, cols: usize, planes: usize) {
+        let n = rows * cols * planes;
+        (self.rows, self.cols, self.planes) = (rows, cols, planes);
+        self.point_in_vehicle.resize(n, Vec3::NAN);
+        self.range_m.resize(n, f32::NAN);
+        self.intensity.resize(n, 0.0);
+        self.ring.resize(n, 0);
+        self.column.resize(n, 0);
+        self.sensor.resize(n, u8::MAX);
+        self.time_s.resize(n, 0.0);
+        self.echo.resize(n, 0);
+        self.label.resize(n, SemanticClass::UNLABELED);
+        self.instance.resize(n, 0);
+        self.ground.resize(n, false);
+        self.normal.resize(n, Vec3::ZERO);
+    }
+
     /// Sets cells `range` back to no-return cells (as [`OrderedCloud::empty`] makes them).
     pub fn reset_cells(&mut self, range: std::ops::Range<usize>) {
         self.point_in_vehicle[range.clone()].fill(Vec3::NAN);

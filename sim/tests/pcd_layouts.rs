@@ -102,3 +102,53 @@ fn truncated_layout_files_are_refused_naming_the_file() {
         assert!(e.contains("cut.pcd"), "{e}");
     }
 }
+
+#[test]
+fn reading_into_a_used_cloud_gives_what_a_fresh_one_gets() {
+    // A cloud whose every field is set away from the defaults, in a larger grid.
+    let mut big = OrderedCloud::empty(9, 30, 1);
+    for i in 0..big.len() {
+        big.point_in_vehicle[i] = Vec3::new(1.0 + i as f32, 2.0, 3.0);
+        big.range_m[i] = 4.0;
+        big.intensity[i] = 0.9;
+        big.ring[i] = 7;
+        big.column[i] = 3;
+        big.sensor[i] = 2;
+        big.time_s[i] = 0.25;
+        big.echo[i] = 0;
+        big.label[i] = SemanticClass::CAR;
+        big.instance[i] = 11;
+        big.ground[i] = true;
+        big.normal[i] = Vec3::Z;
+    }
+    let c = cloud();
+    let xyz_only = {
+        let mut t = String::from(
+            "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n",
+        );
+        t.push_str("1 2 3\nnan nan nan\n0 0 0\n");
+        t.into_bytes()
+    };
+    let files: Vec<(&str, Vec<u8>)> = vec![
+        ("ours.pcd", sim::io::pcd::encode(&c, false).unwrap()),
+        ("ours_ascii.pcd", sim::io::pcd::encode(&c, true).unwrap()),
+        ("velodyne.pcd", encode_layout(&c, PcdLayout::Velodyne, false, None).unwrap()),
+        ("ouster.pcd", encode_layout(&c, PcdLayout::Ouster, false, None).unwrap()),
+        ("xyz.pcd", xyz_only),
+    ];
+    for (name, bytes) in &files {
+        let path = Path::new(name);
+        let (fresh, _) = read_bytes_with_info(path, bytes).unwrap();
+        for (before_name, before) in &files {
+            let mut used = big.clone();
+            sim::io::pcd::read_bytes_into(Path::new(before_name), before, &mut used).unwrap();
+            used.range_m.iter_mut().for_each(|r| *r += 1.0);
+            sim::io::pcd::read_bytes_into(path, bytes, &mut used).unwrap();
+            // Debug output compares NaN no-returns as equal.
+            assert_eq!(format!("{used:?}"), format!("{fresh:?}"), "{name} read after {before_name}");
+        }
+        let mut used = big.clone();
+        sim::io::pcd::read_bytes_into(path, bytes, &mut used).unwrap();
+        assert_eq!(format!("{used:?}"), format!("{fresh:?}"), "{name} read into a larger used cloud");
+    }
+}

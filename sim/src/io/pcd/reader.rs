@@ -127,7 +127,9 @@ pub fn read_bytes_into(path: &Path, bytes: &[u8], cloud: &mut OrderedCloud) -> R
     // loops per field streamed the records from memory once per field.
     let pos = |s: Slot| h.slots[s as usize];
     let (rows1, cols1, plane1) = (rows.max(1), cols.max(1), (rows * cols).max(1));
-    cloud.reset(rows, cols, planes);
+    // Every entry of every field is written once below: from the file, or the default of a
+    // field it does not have.
+    cloud.reshape(rows, cols, planes);
     debug_assert_eq!(cloud.len(), n);
     let OrderedCloud {
         point_in_vehicle,
@@ -144,19 +146,48 @@ pub fn read_bytes_into(path: &Path, bytes: &[u8], cloud: &mut OrderedCloud) -> R
         normal,
         ..
     } = cloud;
-    // Defaults row by row (a division per point cost 1.5 ms a frame).
-    for (k, (rg, cl)) in ring.chunks_mut(cols1).zip(column.chunks_mut(cols1)).enumerate() {
-        rg.fill((k % rows1) as u16);
-        cl.iter_mut().enumerate().for_each(|(c, v)| *v = c as u32);
+    let has = |s: Slot| pos(s).is_some();
+    if !(has(Slot::X) && has(Slot::Y) && has(Slot::Z)) {
+        point_in_vehicle.fill(Vec3::NAN);
     }
-    sensor.fill(0);
-    for (k, e) in echo.chunks_mut(plane1).enumerate() {
-        e.fill(k as u8);
+    if !has(Slot::Intensity) {
+        intensity.fill(0.0);
+    }
+    // Defaults row by row (a division per point cost 1.5 ms a frame).
+    if !has(Slot::Ring) {
+        for (k, rg) in ring.chunks_mut(cols1).enumerate() {
+            rg.fill((k % rows1) as u16);
+        }
+    }
+    if !has(Slot::Column) {
+        for cl in column.chunks_mut(cols1) {
+            cl.iter_mut().enumerate().for_each(|(c, v)| *v = c as u32);
+        }
+    }
+    if !has(Slot::Sensor) {
+        sensor.fill(0);
+    }
+    if !has(Slot::Time) {
+        time_s.fill(0.0);
+    }
+    if !has(Slot::Echo) {
+        for (k, e) in echo.chunks_mut(plane1).enumerate() {
+            e.fill(k as u8);
+        }
+    }
+    if !has(Slot::Label) {
+        label.fill(SemanticClass::UNLABELED);
+    }
+    if !has(Slot::Instance) {
+        instance.fill(0);
     }
     let (mm, ns) = (info.range_in_mm, info.time_in_ns);
-    let normals = pos(Slot::Nx).is_some() && pos(Slot::Ny).is_some() && pos(Slot::Nz).is_some();
+    let normals = has(Slot::Nx) && has(Slot::Ny) && has(Slot::Nz);
+    if !normals {
+        normal.fill(Vec3::ZERO);
+    }
     // A file's own `range` field replaces the length below (a return's mark until then).
-    let has_range = pos(Slot::Range).is_some();
+    let has_range = has(Slot::Range);
     for b0 in (0..n).step_by(BLOCK) {
         let b = b0..(b0 + BLOCK).min(n);
         if !src.f32_triple(pos(Slot::X), pos(Slot::Y), pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()]) {
@@ -168,17 +199,28 @@ pub fn read_bytes_into(path: &Path, bytes: &[u8], cloud: &mut OrderedCloud) -> R
             // Drivers that keep no-return cells as zeros (ouster-ros, older velodyne): no return.
             let zero = *p == Vec3::ZERO;
             info.zero_cells += usize::from(zero);
-            if p.is_finite() && !zero {
-                *r = if has_range { 0.0 } else { p.length() };
+            let is_return = p.is_finite() & !zero;
+            *r = if !is_return {
+                f32::NAN
+            } else if has_range {
+                0.0
             } else {
-                *p = Vec3::NAN;
-            }
+                p.length()
+            };
+            *p = if is_return { *p } else { Vec3::NAN };
         }
-        field(&src, pos(Slot::Range), b.clone(), &mut range_m[b.clone()], |r, v| {
+        // The range of returns (no-returns keep their NaN), from the common `uint32` millimetres
+        // or metres straight, else through `f64` (the same values).
+        let range = |r: &mut f32, v: f64| {
             if r.is_finite() {
                 *r = if mm { (v * 1e-3) as f32 } else { v as f32 };
             }
-        });
+        };
+        if !src.direct::<_, u32>(pos(Slot::Range), Scalar::U(4), b.clone(), &mut range_m[b.clone()], |r, v| {
+            range(r, f64::from(v))
+        }) {
+            field(&src, pos(Slot::Range), b.clone(), &mut range_m[b.clone()], range);
+        }
         // Typed reads where the file's type is the common one (the same values as through `f64`).
         if !src
             .direct::<_, f32>(pos(Slot::Intensity), Scalar::F(4), b.clone(), &mut intensity[b.clone()], |o, v| *o = v)
@@ -190,7 +232,12 @@ pub fn read_bytes_into(path: &Path, bytes: &[u8], cloud: &mut OrderedCloud) -> R
         }
         field(&src, pos(Slot::Column), b.clone(), &mut column[b.clone()], |o, v| *o = v as u32);
         field(&src, pos(Slot::Sensor), b.clone(), &mut sensor[b.clone()], |o, v| *o = v as u8);
-        field(&src, pos(Slot::Time), b.clone(), &mut time_s[b.clone()], |o, v| *o = if ns { v * 1e-9 } else { v });
+        let time = |o: &mut f64, v: f64| *o = if ns { v * 1e-9 } else { v };
+        if !src.direct::<_, u32>(pos(Slot::Time), Scalar::U(4), b.clone(), &mut time_s[b.clone()], |o, v| {
+            time(o, f64::from(v))
+        }) {
+            field(&src, pos(Slot::Time), b.clone(), &mut time_s[b.clone()], time);
+        }
         field(&src, pos(Slot::Echo), b.clone(), &mut echo[b.clone()], |o, v| *o = v as u8);
         // A label above 65535 saturates, as the `f64` cast below does.
         let label_u32 = |o: &mut SemanticClass, v: u32| *o = SemanticClass(u16::try_from(v).unwrap_or(u16::MAX));
