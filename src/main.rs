@@ -3,6 +3,7 @@
 
 mod alloc;
 mod cli;
+mod input_bytes;
 mod plot;
 
 use clap::Parser;

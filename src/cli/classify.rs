@@ -35,6 +35,8 @@ use classifier::ordering::{
 use glam::{Affine3A, Mat4};
 use sim::OrderedCloud;
 
+use crate::input_bytes::InputBytes;
+
 /// Arguments of `groundtruth classify`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -191,9 +193,9 @@ impl SensorSetup {
 #[derive(Default)]
 pub(crate) struct FrameReader {
     /// The file's bytes.
-    bytes: Vec<u8>,
+    bytes: InputBytes,
     /// A KITTI `.label`'s bytes.
-    label_bytes: Vec<u8>,
+    label_bytes: InputBytes,
     /// A KITTI file's records.
     flat: sim::io::kitti::KittiPoints,
     /// A PCD as the file holds it (ordered from here where it is not organized).
@@ -225,8 +227,8 @@ impl FrameReader {
         self.ordered = false;
         match path.extension().and_then(|e| e.to_str()) {
             Some("pcd") => {
-                sim::io::read_file_into(path, &mut self.bytes)?;
-                let info = sim::io::pcd::read_bytes_into(path, &self.bytes, &mut self.file_cloud)?;
+                let bytes = self.bytes.load(path)?;
+                let info = sim::io::pcd::read_bytes_into(path, bytes, &mut self.file_cloud)?;
                 let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                 if info.ours || self.file_cloud.planes > 1 {
                     std::mem::swap(&mut self.cloud, &mut self.file_cloud);
@@ -265,13 +267,12 @@ impl FrameReader {
             }
             Some("bin") => {
                 let label = path.with_extension("label");
-                sim::io::read_file_into(path, &mut self.bytes)?;
-                let has_label = label.is_file();
-                if has_label {
-                    sim::io::read_file_into(&label, &mut self.label_bytes)?;
-                }
-                let label_bytes = has_label.then_some((label.as_path(), self.label_bytes.as_slice()));
-                sim::io::kitti::points_from_bytes_into(path, &self.bytes, label_bytes, &mut self.flat)?;
+                let bytes = self.bytes.load(path)?;
+                let label_bytes = match label.is_file() {
+                    true => Some((label.as_path(), self.label_bytes.load(&label)?)),
+                    false => None,
+                };
+                sim::io::kitti::points_from_bytes_into(path, bytes, label_bytes, &mut self.flat)?;
                 let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                 let flat = &self.flat;
                 let attributes = PointAttributes {

@@ -417,8 +417,8 @@ fn fast_block(
     // 1 in a dense block (two wide compares rather than 18 byte loads and ands).
     let cv: &[u8; L + 2] = plane.column3[i0 - 1..i0 + L + 1].try_into().expect("L + 2 flags");
     let (head, tail) = cv.split_at(L);
-    let dense = u128::from_ne_bytes(head.try_into().expect("16 flags")) == u128::from_ne_bytes([1; 16])
-        && tail == [1, 1];
+    let dense =
+        u128::from_ne_bytes(head.try_into().expect("16 flags")) == u128::from_ne_bytes([1; 16]) && tail == [1, 1];
     if !dense && !plane.valid[i0..i0 + L].iter().any(|&v| v) {
         out.zero(i0, L);
         return;
