@@ -90,24 +90,8 @@ impl OrderedCloud {
     /// assert!(cloud.sensor.iter().all(|&s| s == u8::MAX));
     /// ```
     pub fn reset(&mut self, rows: usize, cols: usize, planes: usize) {
-        fn refill<T: Clone>(v: &mut Vec<T>, value: T, n: usize) {
-            v.clear();
-            v.resize(n, value);
-        }
-        let n = rows * cols * planes;
-        (self.rows, self.cols, self.planes) = (rows, cols, planes);
-        refill(&mut self.point_in_vehicle, Vec3::NAN, n);
-        refill(&mut self.range_m, f32::NAN, n);
-        refill(&mut self.intensity, 0.0, n);
-        refill(&mut self.ring, 0, n);
-        refill(&mut self.column, 0, n);
-        refill(&mut self.sensor, u8::MAX, n);
-        refill(&mut self.time_s, 0.0, n);
-        refill(&mut self.echo, 0, n);
-        refill(&mut self.label, SemanticClass::UNLABELED, n);
-        refill(&mut self.instance, 0, n);
-        refill(&mut self.ground, false, n);
-        refill(&mut self.normal, Vec3::ZERO, n);
+        self.reshape(rows, cols, planes);
+        self.reset_cells(0..self.len());
     }
 
     /// Gives every field `planes * rows * cols` entries without setting them: the entries kept
