@@ -154,6 +154,23 @@ fn organized_top_first_or_without_ring_gives_the_bottom_first_decisions() {
     let mut twice = top.clone();
     twice.ring[..cols].fill(1);
     assert!(order_organized(twice, true, Affine3A::IDENTITY).unwrap_err().to_string().contains("more than one row"));
+    // A row holding two ring values, the other one in its last cell: refused, naming both.
+    let mut mixed = top.clone();
+    mixed.ring[2 * cols - 1] = 7;
+    let e = order_organized(mixed, true, Affine3A::IDENTITY).unwrap_err().to_string();
+    assert!(e.contains("row 1 holds rings 1 and 7"), "{e}");
+    // Normals turn with the points into the vehicle frame; a cloud without normals keeps zeros.
+    let yaw = Affine3A::from_rotation_z(std::f32::consts::FRAC_PI_2) * Affine3A::from_translation(Vec3::Z);
+    let mut no_normals = top.clone();
+    no_normals.normal.fill(Vec3::ZERO);
+    let (turned, _) = order_organized(no_normals.clone(), true, yaw).unwrap();
+    assert!(turned.normal.iter().all(|n| *n == Vec3::ZERO));
+    let mut with_normal = no_normals;
+    with_normal.normal[5 * cols + 3] = Vec3::X;
+    let (turned, _) = order_organized(with_normal, true, yaw).unwrap();
+    let moved = turned.normal[(rows - 1 - 5) * cols + 3];
+    assert!((moved - Vec3::Y).length() < 1e-6, "{moved}");
+    assert_eq!(turned.normal.iter().filter(|n| **n != Vec3::ZERO).count(), 1);
     // No way up to tell: every row the same.
     let mut flat = top.clone();
     let fullest = (0..rows)

