@@ -38,7 +38,7 @@ use sim::{OrderedCloud, SemanticClass};
 
 pub use beam_table::{BeamTable, TableRows};
 pub use calibration::{Calibration, CalibrationError};
-pub use organized::{order_organized, order_organized_in_place};
+pub use organized::{order_organized, order_organized_in_place, read_organized_into};
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};
 pub use unfold::UnfoldParams;

@@ -20,6 +20,11 @@
 //! beyond it in opposite directions, the layout cannot be told and the cloud is refused with a
 //! message, never guessed. Decisions come back in the input's own cell order through
 //! [`OrderingReport::cell_of_point`].
+//!
+//! Two ways in, with the same result (tested): [`order_organized`] reorders a cloud read as the
+//! file stores it, moving every field's rows; [`read_organized_into`] tells the rows' order from
+//! single points of a parsed file ([`sim::io::pcd::PcdFrame`]) and then decodes each file row
+//! straight into its row, in the vehicle frame (what `classify` does with a driver's file).
 
 use sim::OrderedCloud;
 
@@ -60,114 +65,21 @@ pub fn order_organized_in_place(
 ) -> Result<()> {
     crate::error::check_cloud(cloud)?;
     let (rows, cols) = (cloud.rows, cloud.cols);
-    if cloud.planes != 1 {
-        return Err(ClassifyError::Ordering(format!(
-            "an organized cloud of {} planes: only our own files (which say so) have echo planes",
-            cloud.planes
-        )));
-    }
-    // The ring of each file row.
-    let mut ring_of_row = vec![0usize; rows];
-    let mut seen = vec![false; rows];
-    for (k, ring) in ring_of_row.iter_mut().enumerate() {
-        let g = if has_ring {
-            let cells = &cloud.ring[k * cols..(k + 1) * cols];
-            let g = cells[0];
-            // An or over the row (vectorized) first; the search for the message only on a mismatch.
-            let differs = cells.iter().fold(0, |acc, &x| acc | (x ^ g)) != 0;
-            if let Some(other) = differs.then(|| cells.iter().find(|&&x| x != g)).flatten() {
-                return Err(ClassifyError::Ordering(format!(
-                    "row {k} holds rings {g} and {other}: the `ring` field does not follow the rows"
-                )));
-            }
-            g as usize
-        } else {
-            k
-        };
-        if g >= rows {
-            return Err(ClassifyError::Ordering(format!("ring {g} in row {k} is out of range 0 ..= {}", rows - 1)));
-        }
-        if seen[g] {
-            return Err(ClassifyError::Ordering(format!("ring {g} appears in more than one row")));
-        }
-        seen[g] = true;
-        *ring = g;
-    }
-    // Which way up: in each column, the points of neighbouring rings on one surface (closer than
-    // `SAME_SURFACE` of their distance) step up or out from the lower beam to the upper one.
-    let mut row_of_ring = vec![0usize; rows];
-    for (k, &g) in ring_of_row.iter().enumerate() {
-        row_of_ring[g] = k;
-    }
-    let (mut up, mut down, mut rings_with_returns) = (0usize, 0usize, 0usize);
-    let (mut higher, mut lower) = (0usize, 0usize);
-    // Every `stride`-th column votes (at least `VOTING_COLUMNS` of them): tens of thousands of
-    // votes decide as well as all 131,072 pairs of a 128 x 1024 frame, at an eighth of the cost.
-    let stride = (cols / VOTING_COLUMNS).max(1);
-    for g in 0..rows {
-        let a = row_of_ring[g] * cols;
-        rings_with_returns += usize::from(cloud.point_in_vehicle[a..a + cols].iter().any(|p| p.is_finite()));
-        if g + 1 == rows {
-            break;
-        }
-        let b = row_of_ring[g + 1] * cols;
-        for c in (0..cols).step_by(stride) {
-            let (p, q) = (cloud.point_in_vehicle[a + c], cloud.point_in_vehicle[b + c]);
-            if !(p.is_finite() && q.is_finite()) {
-                continue;
-            }
-            let (dp, dq) = ((p.x * p.x + p.y * p.y).sqrt(), (q.x * q.x + q.y * q.y).sqrt());
-            // Elevation seen from the origin: `q.z / dq` against `p.z / dp`, without divisions.
-            let (eq, ep) = (q.z * dp, p.z * dq);
-            higher += usize::from(eq > ep);
-            lower += usize::from(eq < ep);
-            if p.distance(q) > SAME_SURFACE * dp.min(dq) {
-                continue;
-            }
-            let step = (q.z - p.z) + (dq - dp);
-            if step > 0.0 {
-                up += 1;
-            } else if step < 0.0 {
-                down += 1;
-            }
-        }
-    }
-    if rings_with_returns < 2 {
-        return Err(ClassifyError::Ordering(format!("{rings_with_returns} rings hold returns: fewer than two")));
-    }
-    let balance = |up: usize, down: usize| (up as f32 - down as f32) / (up + down).max(1) as f32;
-    let (elevation, surface) = (balance(higher, lower), balance(up, down));
-    let lean = |score: f32| {
-        if score > MIN_DIRECTION_SCORE {
-            Some(true)
-        } else if score < -MIN_DIRECTION_SCORE {
-            Some(false)
-        } else {
-            None
-        }
-    };
-    let bottom_first = match (lean(elevation), lean(surface)) {
-        (Some(a), Some(b)) if a != b => {
-            return Err(ClassifyError::Ordering(format!(
-                "cannot tell which way up the rows are stored: seen from the file's origin the rings rise {} (balance {elevation:.2}), but neighbouring points on one surface step the other way (balance {surface:.2})",
-                if a { "upwards" } else { "downwards" }
-            )));
-        }
-        (Some(a), _) | (None, Some(a)) => a,
-        (None, None) => {
-            return Err(ClassifyError::Ordering(format!(
-                "cannot tell which way up the rows are stored ({higher} neighbouring pairs rise in elevation and {lower} fall, {up} step up on one surface and {down} down; needs a balance beyond +-{MIN_DIRECTION_SCORE})"
-            )));
-        }
-    };
-    let new_row: Vec<usize> = ring_of_row.iter().map(|&g| if bottom_first { g } else { rows - 1 - g }).collect();
+    check_one_plane(cloud.planes)?;
+    let ring_of_row = rings_of_rows(rows, |k| match has_ring {
+        true => one_ring(k, &cloud.ring[k * cols..(k + 1) * cols]),
+        false => Ok(k),
+    })?;
+    let votes = Votes::count(rows, cols, &ring_of_row, |i| cloud.point_in_vehicle[i]);
+    let rings_with_returns = rings_with_returns(&cloud.point_in_vehicle, cols)?;
+    let new_row = rows_in_order(&ring_of_row, votes.bottom_first()?);
     let out = cloud;
     macro_rules! permute {
         ($($f:ident),*) => {$( permute_rows(&mut out.$f, cols, &new_row); )*};
     }
     permute!(point_in_vehicle, range_m, intensity, ring, column, sensor, time_s, echo, label, instance, ground, normal);
     if vehicle_from_sensor != glam::Affine3A::IDENTITY {
-        transform_returns(vehicle_from_sensor, &mut out.point_in_vehicle);
+        sim::cloud::transform_returns(vehicle_from_sensor, &mut out.point_in_vehicle);
         // The drivers' layouts carry no normals: zero normals stay zero.
         // A branch-free or over the normals (vectorized): `any` with `!=` cost 0.15 ms a frame.
         let nonzero = |n: &glam::Vec3| (n.x != 0.0) | (n.y != 0.0) | (n.z != 0.0);
@@ -177,34 +89,206 @@ pub fn order_organized_in_place(
             }
         }
     }
-    let mut cell_of_point = std::mem::take(&mut report.cell_of_point);
-    cell_of_point.clear();
-    *report = OrderingReport { path: OrderingPath::Organized, cell_of_point, ..OrderingReport::default() };
-    for &r in &new_row {
-        // A range of known length: `extend` writes it without a capacity check per cell.
-        report.cell_of_point.extend((r * cols..(r + 1) * cols).map(|i| Some(i as u32)));
-    }
-    report.placed = out.returns();
-    report.no_returns = rows * cols - report.placed;
-    report.rings_found = rings_with_returns;
+    fill_report(report, &new_row, cols, out.returns(), rings_with_returns);
     Ok(())
 }
 
-/// `vehicle_from_sensor.transform_point3` of every finite point of `points`, in place (no-returns
-/// stay as they are). Written out per coordinate in the operations of glam's `transform_point3`
-/// (`((x_axis x + y_axis y) + z_axis z) + translation`, the same bits), with the no-returns put
-/// back by a select: the loop vectorizes, where a call per point and a branch did not.
-fn transform_returns(vehicle_from_sensor: glam::Affine3A, points: &mut [glam::Vec3]) {
-    let m = vehicle_from_sensor.matrix3;
-    let (xa, ya, za, t) = (m.x_axis, m.y_axis, m.z_axis, vehicle_from_sensor.translation);
-    for p in points {
-        let q = glam::Vec3::new(
-            ((xa.x * p.x + ya.x * p.y) + za.x * p.z) + t.x,
-            ((xa.y * p.x + ya.y * p.y) + za.y * p.z) + t.y,
-            ((xa.z * p.x + ya.z * p.y) + za.z * p.z) + t.z,
-        );
-        *p = if p.is_finite() { q } else { *p };
+/// Reads an organized PCD `frame` (one plane) into `cloud` with its rows in elevation order and its
+/// points in the vehicle frame, in one pass over the file: the rows' rings and which way up they
+/// are (the votes of [`order_organized`], on the same points) are told from single points first,
+/// then every file row is decoded straight into its row, its points moved by
+/// `vehicle_from_sensor` as they are read. The same cloud and report as
+/// [`sim::io::pcd::read_bytes_into`] then [`order_organized_in_place`] (tested), without moving
+/// every field's rows and every point a second time (0.5 ms of a 128 x 1024 ouster-ros frame).
+/// Also refused as there, except that a row holding two rings is found after the reading, so
+/// another row's bad ring is named first where a file has both. On an error `cloud` holds no
+/// meaningful content.
+pub fn read_organized_into(
+    frame: &sim::io::pcd::PcdFrame<'_>,
+    vehicle_from_sensor: glam::Affine3A,
+    cloud: &mut OrderedCloud,
+    report: &mut OrderingReport,
+) -> Result<sim::io::pcd::PcdInfo> {
+    let (rows, cols, planes) = frame.shape();
+    if rows < 2 || cols < 2 || planes == 0 {
+        return Err(ClassifyError::TooSmall { rows, cols, planes });
     }
+    check_one_plane(planes)?;
+    let has_ring = frame.info().has_ring;
+    let ring_of_row = rings_of_rows(rows, |k| match has_ring {
+        true => Ok(usize::from(frame.ring(k * cols).unwrap_or(0))),
+        false => Ok(k),
+    })?;
+    let votes = Votes::count(rows, cols, &ring_of_row, |i| frame.point(i));
+    let bottom_first = votes.bottom_first();
+    // Read in the file's order where the direction cannot be told: its error comes after the
+    // count of rings with returns, as in `order_organized_in_place`.
+    let new_row = rows_in_order(&ring_of_row, *bottom_first.as_ref().unwrap_or(&true));
+    let info = frame
+        .read_into(cloud, Some(&new_row), vehicle_from_sensor)
+        .map_err(|e| ClassifyError::Ordering(e.to_string()))?;
+    if has_ring {
+        for (k, &d) in new_row.iter().enumerate() {
+            one_ring(k, &cloud.ring[d * cols..(d + 1) * cols])?;
+        }
+    }
+    let rings_with_returns = rings_with_returns(&cloud.point_in_vehicle, cols)?;
+    bottom_first?;
+    fill_report(report, &new_row, cols, cloud.returns(), rings_with_returns);
+    Ok(info)
+}
+
+/// Refuses clouds of more than one echo plane.
+fn check_one_plane(planes: usize) -> Result<()> {
+    if planes != 1 {
+        return Err(ClassifyError::Ordering(format!(
+            "an organized cloud of {planes} planes: only our own files (which say so) have echo planes"
+        )));
+    }
+    Ok(())
+}
+
+/// The ring of file row `k` from its cells' `ring` values, which must all be one.
+fn one_ring(k: usize, cells: &[u16]) -> Result<usize> {
+    let g = cells[0];
+    // An or over the row (vectorized) first; the search for the message only on a mismatch.
+    let differs = cells.iter().fold(0, |acc, &x| acc | (x ^ g)) != 0;
+    if let Some(other) = differs.then(|| cells.iter().find(|&&x| x != g)).flatten() {
+        return Err(ClassifyError::Ordering(format!(
+            "row {k} holds rings {g} and {other}: the `ring` field does not follow the rows"
+        )));
+    }
+    Ok(usize::from(g))
+}
+
+/// The ring of each of the `rows` file rows (`ring_of(k)`), each below the row count and every
+/// row a different one.
+fn rings_of_rows(rows: usize, ring_of: impl Fn(usize) -> Result<usize>) -> Result<Vec<usize>> {
+    let mut ring_of_row = vec![0usize; rows];
+    let mut seen = vec![false; rows];
+    for (k, ring) in ring_of_row.iter_mut().enumerate() {
+        let g = ring_of(k)?;
+        if g >= rows {
+            return Err(ClassifyError::Ordering(format!("ring {g} in row {k} is out of range 0 ..= {}", rows - 1)));
+        }
+        if seen[g] {
+            return Err(ClassifyError::Ordering(format!("ring {g} appears in more than one row")));
+        }
+        seen[g] = true;
+        *ring = g;
+    }
+    Ok(ring_of_row)
+}
+
+/// Rows of `cols` points of which at least one is a return; refused below two.
+fn rings_with_returns(points: &[glam::Vec3], cols: usize) -> Result<usize> {
+    let n = points.chunks_exact(cols).filter(|row| row.iter().any(|p| p.is_finite())).count();
+    if n < 2 {
+        return Err(ClassifyError::Ordering(format!("{n} rings hold returns: fewer than two")));
+    }
+    Ok(n)
+}
+
+/// The new row of each file row: its ring, or counted from the top where ring 0 is the top beam.
+fn rows_in_order(ring_of_row: &[usize], bottom_first: bool) -> Vec<usize> {
+    let rows = ring_of_row.len();
+    ring_of_row.iter().map(|&g| if bottom_first { g } else { rows - 1 - g }).collect()
+}
+
+/// The two votes on which way up the rows are (see the module docs).
+struct Votes {
+    /// Neighbouring pairs whose upper ring's point is higher / lower in elevation.
+    higher: usize,
+    lower: usize,
+    /// Pairs on one surface that step up / down from the lower ring to the upper one.
+    up: usize,
+    down: usize,
+}
+
+impl Votes {
+    /// The votes over the pairs of neighbouring rings' points (`point(i)`, file order, no-returns
+    /// not finite) in every `cols / VOTING_COLUMNS`-th column.
+    fn count(rows: usize, cols: usize, ring_of_row: &[usize], point: impl Fn(usize) -> glam::Vec3) -> Self {
+        let mut row_of_ring = vec![0usize; rows];
+        for (k, &g) in ring_of_row.iter().enumerate() {
+            row_of_ring[g] = k;
+        }
+        let mut votes = Votes { higher: 0, lower: 0, up: 0, down: 0 };
+        // Every `stride`-th column votes (at least `VOTING_COLUMNS` of them): tens of thousands of
+        // votes decide as well as all 131,072 pairs of a 128 x 1024 frame, at an eighth of the cost.
+        let stride = (cols / VOTING_COLUMNS).max(1);
+        let m = cols.div_ceil(stride);
+        // Each voting point read once, in file order: read from a file's records, two rings at a
+        // time, each twice, they cost 0.75 ms of a 128 x 1024 frame in cache misses.
+        let mut sampled = Vec::with_capacity(rows * m);
+        for k in 0..rows {
+            sampled.extend((0..cols).step_by(stride).map(|c| point(k * cols + c)));
+        }
+        for g in 0..rows.saturating_sub(1) {
+            let (a, b) = (row_of_ring[g] * m, row_of_ring[g + 1] * m);
+            for j in 0..m {
+                let (p, q) = (sampled[a + j], sampled[b + j]);
+                if !(p.is_finite() && q.is_finite()) {
+                    continue;
+                }
+                let (dp, dq) = ((p.x * p.x + p.y * p.y).sqrt(), (q.x * q.x + q.y * q.y).sqrt());
+                // Elevation seen from the origin: `q.z / dq` against `p.z / dp`, without divisions.
+                let (eq, ep) = (q.z * dp, p.z * dq);
+                votes.higher += usize::from(eq > ep);
+                votes.lower += usize::from(eq < ep);
+                if p.distance(q) > SAME_SURFACE * dp.min(dq) {
+                    continue;
+                }
+                let step = (q.z - p.z) + (dq - dp);
+                if step > 0.0 {
+                    votes.up += 1;
+                } else if step < 0.0 {
+                    votes.down += 1;
+                }
+            }
+        }
+        votes
+    }
+
+    /// Whether ring 0 is the bottom beam, as the votes tell; refused where they cannot tell.
+    fn bottom_first(&self) -> Result<bool> {
+        let Votes { higher, lower, up, down } = *self;
+        let balance = |up: usize, down: usize| (up as f32 - down as f32) / (up + down).max(1) as f32;
+        let (elevation, surface) = (balance(higher, lower), balance(up, down));
+        let lean = |score: f32| {
+            if score > MIN_DIRECTION_SCORE {
+                Some(true)
+            } else if score < -MIN_DIRECTION_SCORE {
+                Some(false)
+            } else {
+                None
+            }
+        };
+        match (lean(elevation), lean(surface)) {
+            (Some(a), Some(b)) if a != b => Err(ClassifyError::Ordering(format!(
+                "cannot tell which way up the rows are stored: seen from the file's origin the rings rise {} (balance {elevation:.2}), but neighbouring points on one surface step the other way (balance {surface:.2})",
+                if a { "upwards" } else { "downwards" }
+            ))),
+            (Some(a), _) | (None, Some(a)) => Ok(a),
+            (None, None) => Err(ClassifyError::Ordering(format!(
+                "cannot tell which way up the rows are stored ({higher} neighbouring pairs rise in elevation and {lower} fall, {up} step up on one surface and {down} down; needs a balance beyond +-{MIN_DIRECTION_SCORE})"
+            ))),
+        }
+    }
+}
+
+/// The report of an organized cloud whose file row `k` went to row `new_row[k]`.
+fn fill_report(report: &mut OrderingReport, new_row: &[usize], cols: usize, placed: usize, rings: usize) {
+    let mut cell_of_point = std::mem::take(&mut report.cell_of_point);
+    cell_of_point.clear();
+    *report = OrderingReport { path: OrderingPath::Organized, cell_of_point, ..OrderingReport::default() };
+    for &r in new_row {
+        // A range of known length: `extend` writes it without a capacity check per cell.
+        report.cell_of_point.extend((r * cols..(r + 1) * cols).map(|i| Some(i as u32)));
+    }
+    report.placed = placed;
+    report.no_returns = new_row.len() * cols - placed;
+    report.rings_found = rings;
 }
 
 /// Whether [`order_organized`] found the file top-first: its first row went to the top.

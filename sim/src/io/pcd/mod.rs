@@ -20,14 +20,20 @@
 //! has a `ring` field and our grid line, for `classifier::ordering` to put the rows in elevation
 //! order.
 //!
+//! [`PcdFrame`] parses a file without decoding it, so that single points can be looked at first
+//! and the whole file then decoded with its rows where the caller wants them and its points moved
+//! into the vehicle frame, in one pass (to put a driver's rows in elevation order as they are
+//! decoded, for instance).
+//!
 //! The writer writes our layout ([`encode`], rows bottom-first) or a ROS driver's
 //! ([`encode_layout`], [`PcdLayout`]).
 
+mod decode;
 mod header;
 mod layouts;
 mod reader;
 mod writer;
 
 pub use layouts::{PcdLayout, encode_layout, write_layout};
-pub use reader::{PcdInfo, read, read_bytes, read_bytes_into, read_bytes_with_info, read_with_info};
+pub use reader::{PcdFrame, PcdInfo, read, read_bytes, read_bytes_into, read_bytes_with_info, read_with_info};
 pub use writer::{RECORD_BYTES, encode, write};

@@ -3,14 +3,14 @@
 
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 
 use super::super::read_util::Scalar;
 use super::super::read_util::read_file;
-use super::header::{DataKind, FieldPos, Slot, decompress_fields, parse_header};
+use super::decode::{Decoder, Source, field, parse_ascii};
+use super::header::{DataKind, Header, Slot, decompress_fields, parse_header};
 use crate::cloud::OrderedCloud;
 use crate::error::{Result, SimError};
-use crate::scene::SemanticClass;
 
 /// Reads a PCD file into an ordered cloud (see the module docs for the mapping).
 pub fn read(path: &Path) -> Result<OrderedCloud> {
@@ -57,390 +57,213 @@ pub fn read_bytes_with_info(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
 /// read one after another allocates nothing once they are large enough). On an error `cloud`
 /// holds no meaningful content.
 pub fn read_bytes_into(path: &Path, bytes: &[u8], cloud: &mut OrderedCloud) -> Result<PcdInfo> {
-    let h = parse_header(path, bytes)?;
-    let integer = |s: Slot| h.slots[s as usize].is_some_and(|p| !matches!(p.scalar, Scalar::F(_)));
-    let mut info = PcdInfo {
-        has_ring: h.slots[Slot::Ring as usize].is_some(),
-        organized: h.height > 1,
-        ours: h.grid.is_some(),
-        zero_cells: 0,
-        range_in_mm: integer(Slot::Range),
-        time_in_ns: integer(Slot::Time),
-    };
-    let bad = |m: String| SimError::bad_file(path, m);
-    let decompressed;
-    let body = match h.data {
-        DataKind::Compressed => {
-            decompressed = decompress_fields(path, &h, &bytes[h.data_start..])?;
-            &decompressed[..]
-        }
-        _ => &bytes[h.data_start..],
-    };
-    // Check the declared size against the data before allocating anything of that size.
-    let mut ascii_lines: Vec<&[u8]> = Vec::new();
-    match h.data {
-        DataKind::Binary | DataKind::Compressed => {
-            let need = h.points.checked_mul(h.record_bytes).ok_or_else(|| bad("PCD: data size overflows".into()))?;
-            if body.len() != need {
-                return Err(bad(format!(
-                    "PCD header declares {} points of {} bytes ({need} bytes) but the file holds {} data bytes",
-                    h.points,
-                    h.record_bytes,
-                    body.len()
-                )));
+    PcdFrame::parse(path, bytes)?.read_into(cloud, None, Affine3A::IDENTITY)
+}
+
+/// A PCD file's header and data, parsed and checked against each other but not yet decoded: single
+/// points can be looked at first ([`PcdFrame::point`], [`PcdFrame::ring`]), for instance to tell
+/// which way up an organized file's rows are, and the whole file then read with its rows where
+/// they belong and its points in the frame they belong in ([`PcdFrame::read_into`]), in one pass.
+///
+/// ```
+/// use std::path::Path;
+/// use sim::io::pcd::{PcdFrame, PcdLayout, encode_layout};
+/// let mut cloud = sim::OrderedCloud::empty(2, 3, 1);
+/// for (i, (p, r)) in cloud.point_in_vehicle.iter_mut().zip(&mut cloud.range_m).enumerate() {
+///     *p = glam::Vec3::new(10.0, i as f32, -1.0);
+///     *r = p.length();
+/// }
+/// let bytes = encode_layout(&cloud, PcdLayout::Ouster, false, None).unwrap();
+/// let frame = PcdFrame::parse(Path::new("two_rows.pcd"), &bytes).unwrap();
+/// assert_eq!(frame.shape(), (2, 3, 1));
+/// // ouster-ros writes the top beam first: file row 0 holds cloud row 1.
+/// assert_eq!(frame.point(0), glam::Vec3::new(10.0, 3.0, -1.0));
+/// assert_eq!(frame.ring(0), Some(0));
+/// // Back bottom-first, 1 m higher.
+/// let mut back = sim::OrderedCloud::default();
+/// let lift = glam::Affine3A::from_translation(glam::Vec3::Z);
+/// frame.read_into(&mut back, Some(&[1, 0]), lift).unwrap();
+/// assert_eq!(back.point_in_vehicle[0], glam::Vec3::new(10.0, 0.0, 0.0));
+/// ```
+pub struct PcdFrame<'a> {
+    path: &'a Path,
+    h: Header,
+    data: Data<'a>,
+}
+
+/// A PCD file's data, as [`Source`] reads it.
+enum Data<'a> {
+    /// Binary records in the file's bytes.
+    Binary(&'a [u8]),
+    /// Binary records decompressed from `binary_compressed` data.
+    Decompressed(Vec<u8>),
+    /// ASCII values, `tokens` a point.
+    Ascii(Vec<f64>),
+}
+
+impl<'a> PcdFrame<'a> {
+    /// Parses the header of PCD `bytes` (read from `path`, named in errors) and checks the data
+    /// against it (ASCII data is parsed here, compressed data decompressed).
+    pub fn parse(path: &'a Path, bytes: &'a [u8]) -> Result<Self> {
+        let h = parse_header(path, bytes)?;
+        let bad = |m: String| SimError::bad_file(path, m);
+        let body = &bytes[h.data_start..];
+        let data = match h.data {
+            DataKind::Binary => {
+                check_binary_size(path, &h, body.len())?;
+                Data::Binary(body)
             }
-        }
-        DataKind::Ascii => {
-            ascii_lines = body.split(|&b| b == b'\n').filter(|l| l.iter().any(|b| !b.is_ascii_whitespace())).collect();
-            if ascii_lines.len() != h.points {
-                return Err(bad(format!(
-                    "PCD header declares {} points but the ASCII data has {} lines",
-                    h.points,
-                    ascii_lines.len()
-                )));
+            // Checked against the header while decompressing, and again here.
+            DataKind::Compressed => {
+                let records = decompress_fields(path, &h, body)?;
+                check_binary_size(path, &h, records.len())?;
+                Data::Decompressed(records)
             }
-        }
-    }
-    let (rows, cols, planes) = if h.height > 1 {
-        match h.grid {
-            Some((r, p)) if r > 0 && p > 0 && r.checked_mul(p) == Some(h.height) => (r, h.width, p),
-            _ => (h.height, h.width, 1),
-        }
-    } else {
-        (1, h.points, 1)
-    };
-    let n = h.points;
-    let src = match h.data {
-        DataKind::Binary | DataKind::Compressed => Source::Binary { body, record: h.record_bytes },
-        DataKind::Ascii => {
-            let mut needed = vec![false; h.tokens];
-            for p in h.slots.iter().flatten() {
-                if let Some(x) = needed.get_mut(p.token) {
-                    *x = true;
+            DataKind::Ascii => {
+                let lines: Vec<&[u8]> =
+                    body.split(|&b| b == b'\n').filter(|l| l.iter().any(|b| !b.is_ascii_whitespace())).collect();
+                if lines.len() != h.points {
+                    return Err(bad(format!(
+                        "PCD header declares {} points but the ASCII data has {} lines",
+                        h.points,
+                        lines.len()
+                    )));
                 }
-            }
-            Source::Ascii { values: parse_ascii(&ascii_lines, h.tokens, &needed, bad)?, tokens: h.tokens }
-        }
-    };
-    // Blocks of points, in each block field by field with the field's type decided once: a
-    // per-point dispatch over every field cost 3 ms of a 128 x 1024 ouster-ros frame, and whole-file
-    // loops per field streamed the records from memory once per field.
-    let pos = |s: Slot| h.slots[s as usize];
-    let (rows1, cols1, plane1) = (rows.max(1), cols.max(1), (rows * cols).max(1));
-    // Every entry of every field is written once below: from the file, or the default of a
-    // field it does not have.
-    cloud.reshape(rows, cols, planes);
-    debug_assert_eq!(cloud.len(), n);
-    let OrderedCloud {
-        point_in_vehicle,
-        range_m,
-        intensity,
-        ring,
-        column,
-        sensor,
-        time_s,
-        echo,
-        label,
-        instance,
-        ground,
-        normal,
-        ..
-    } = cloud;
-    let has = |s: Slot| pos(s).is_some();
-    if !(has(Slot::X) && has(Slot::Y) && has(Slot::Z)) {
-        point_in_vehicle.fill(Vec3::NAN);
-    }
-    if !has(Slot::Intensity) {
-        intensity.fill(0.0);
-    }
-    // Defaults row by row (a division per point cost 1.5 ms a frame).
-    if !has(Slot::Ring) {
-        for (k, rg) in ring.chunks_mut(cols1).enumerate() {
-            rg.fill((k % rows1) as u16);
-        }
-    }
-    if !has(Slot::Column) {
-        for cl in column.chunks_mut(cols1) {
-            cl.iter_mut().enumerate().for_each(|(c, v)| *v = c as u32);
-        }
-    }
-    if !has(Slot::Sensor) {
-        sensor.fill(0);
-    }
-    if !has(Slot::Time) {
-        time_s.fill(0.0);
-    }
-    if !has(Slot::Echo) {
-        for (k, e) in echo.chunks_mut(plane1).enumerate() {
-            e.fill(k as u8);
-        }
-    }
-    if !has(Slot::Label) {
-        label.fill(SemanticClass::UNLABELED);
-    }
-    if !has(Slot::Instance) {
-        instance.fill(0);
-    }
-    let (mm, ns) = (info.range_in_mm, info.time_in_ns);
-    let normals = has(Slot::Nx) && has(Slot::Ny) && has(Slot::Nz);
-    if !normals {
-        normal.fill(Vec3::ZERO);
-    }
-    // A file's own `range` field replaces the length below (a return's mark until then).
-    let has_range = has(Slot::Range);
-    for b0 in (0..n).step_by(BLOCK) {
-        let b = b0..(b0 + BLOCK).min(n);
-        if !src.f32_triple(pos(Slot::X), pos(Slot::Y), pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()]) {
-            field(&src, pos(Slot::X), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.x = v as f32);
-            field(&src, pos(Slot::Y), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.y = v as f32);
-            field(&src, pos(Slot::Z), b.clone(), &mut point_in_vehicle[b.clone()], |o, v| o.z = v as f32);
-        }
-        for (p, r) in point_in_vehicle[b.clone()].iter_mut().zip(&mut range_m[b.clone()]) {
-            // Drivers that keep no-return cells as zeros (ouster-ros, older velodyne): no return.
-            let zero = *p == Vec3::ZERO;
-            info.zero_cells += usize::from(zero);
-            let is_return = p.is_finite() & !zero;
-            *r = if !is_return {
-                f32::NAN
-            } else if has_range {
-                0.0
-            } else {
-                p.length()
-            };
-            *p = if is_return { *p } else { Vec3::NAN };
-        }
-        // The range of returns (no-returns keep their NaN), from the common `uint32` millimetres
-        // or metres straight, else through `f64` (the same values).
-        let range = |r: &mut f32, v: f64| {
-            if r.is_finite() {
-                *r = if mm { (v * 1e-3) as f32 } else { v as f32 };
+                let mut needed = vec![false; h.tokens];
+                for p in h.slots.iter().flatten() {
+                    if let Some(x) = needed.get_mut(p.token) {
+                        *x = true;
+                    }
+                }
+                Data::Ascii(parse_ascii(&lines, h.tokens, &needed, bad)?)
             }
         };
-        if !src.direct::<_, u32>(pos(Slot::Range), Scalar::U(4), b.clone(), &mut range_m[b.clone()], |r, v| {
-            range(r, f64::from(v))
-        }) {
-            field(&src, pos(Slot::Range), b.clone(), &mut range_m[b.clone()], range);
+        Ok(PcdFrame { path, h, data })
+    }
+
+    /// Which conventions the file follows (`zero_cells` is counted by [`PcdFrame::read_into`];
+    /// 0 here).
+    pub fn info(&self) -> PcdInfo {
+        let h = &self.h;
+        let integer = |s: Slot| h.slots[s as usize].is_some_and(|p| !matches!(p.scalar, Scalar::F(_)));
+        PcdInfo {
+            has_ring: h.slots[Slot::Ring as usize].is_some(),
+            organized: h.height > 1,
+            ours: h.grid.is_some(),
+            zero_cells: 0,
+            range_in_mm: integer(Slot::Range),
+            time_in_ns: integer(Slot::Time),
         }
-        // Typed reads where the file's type is the common one (the same values as through `f64`).
-        if !src
-            .direct::<_, f32>(pos(Slot::Intensity), Scalar::F(4), b.clone(), &mut intensity[b.clone()], |o, v| *o = v)
-        {
-            field(&src, pos(Slot::Intensity), b.clone(), &mut intensity[b.clone()], |o, v| *o = v as f32);
-        }
-        if !src.direct::<_, u16>(pos(Slot::Ring), Scalar::U(2), b.clone(), &mut ring[b.clone()], |o, v| *o = v) {
-            field(&src, pos(Slot::Ring), b.clone(), &mut ring[b.clone()], |o, v| *o = v as u16);
-        }
-        field(&src, pos(Slot::Column), b.clone(), &mut column[b.clone()], |o, v| *o = v as u32);
-        field(&src, pos(Slot::Sensor), b.clone(), &mut sensor[b.clone()], |o, v| *o = v as u8);
-        let time = |o: &mut f64, v: f64| *o = if ns { v * 1e-9 } else { v };
-        if !src.direct::<_, u32>(pos(Slot::Time), Scalar::U(4), b.clone(), &mut time_s[b.clone()], |o, v| {
-            time(o, f64::from(v))
-        }) {
-            field(&src, pos(Slot::Time), b.clone(), &mut time_s[b.clone()], time);
-        }
-        field(&src, pos(Slot::Echo), b.clone(), &mut echo[b.clone()], |o, v| *o = v as u8);
-        // A label above 65535 saturates, as the `f64` cast below does.
-        let label_u32 = |o: &mut SemanticClass, v: u32| *o = SemanticClass(u16::try_from(v).unwrap_or(u16::MAX));
-        if !src.direct::<_, u32>(pos(Slot::Label), Scalar::U(4), b.clone(), &mut label[b.clone()], label_u32) {
-            field(&src, pos(Slot::Label), b.clone(), &mut label[b.clone()], |o, v| *o = SemanticClass(v as u16));
-        }
-        field(&src, pos(Slot::Instance), b.clone(), &mut instance[b.clone()], |o, v| *o = v as u32);
-        for ((g, p), l) in ground[b.clone()].iter_mut().zip(&point_in_vehicle[b.clone()]).zip(&label[b.clone()]) {
-            *g = !p.x.is_nan() & l.is_ground();
-        }
-        field(&src, pos(Slot::Ground), b.clone(), &mut ground[b.clone()], |o, v| *o = v != 0.0);
-        if normals {
-            field(&src, pos(Slot::Nx), b.clone(), &mut normal[b.clone()], |o, v| o.x = v as f32);
-            field(&src, pos(Slot::Ny), b.clone(), &mut normal[b.clone()], |o, v| o.y = v as f32);
-            field(&src, pos(Slot::Nz), b.clone(), &mut normal[b.clone()], |o, v| o.z = v as f32);
-            for m in &mut normal[b] {
-                if !m.is_finite() {
-                    *m = Vec3::ZERO;
-                }
+    }
+
+    /// `(rows, cols, planes)` of the cloud [`PcdFrame::read_into`] makes: `HEIGHT x WIDTH` for an
+    /// organized file (our own files' rows and echo planes), `1 x POINTS` for an unorganized one.
+    pub fn shape(&self) -> (usize, usize, usize) {
+        let h = &self.h;
+        if h.height > 1 {
+            match h.grid {
+                Some((r, p)) if r > 0 && p > 0 && r.checked_mul(p) == Some(h.height) => (r, h.width, p),
+                _ => (h.height, h.width, 1),
             }
+        } else {
+            (1, h.points, 1)
         }
     }
-    Ok(info)
-}
 
-/// Points decoded together: a block's records (9 kB of a 36-byte ouster-ros record) stay in the
-/// level-1 cache while each field is read from them.
-const BLOCK: usize = 256;
-
-/// Where the values of the points come from.
-enum Source<'a> {
-    /// Binary records (plain or decompressed), `record` bytes each.
-    Binary { body: &'a [u8], record: usize },
-    /// ASCII values parsed up front, `tokens` a point.
-    Ascii { values: Vec<f64>, tokens: usize },
-}
-
-/// A little-endian scalar read straight from a record.
-trait FromLe: Sized {
-    /// Its size in bytes.
-    const SIZE: usize;
-    /// The value at the start of `b` (`SIZE` bytes or more).
-    fn from_le(b: &[u8]) -> Self;
-}
-
-impl FromLe for f32 {
-    const SIZE: usize = 4;
-    #[inline(always)]
-    fn from_le(b: &[u8]) -> Self {
-        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.h.points
     }
-}
 
-impl FromLe for u32 {
-    const SIZE: usize = 4;
-    #[inline(always)]
-    fn from_le(b: &[u8]) -> Self {
-        u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    /// Whether the file holds no points.
+    pub fn is_empty(&self) -> bool {
+        self.h.points == 0
     }
-}
 
-impl FromLe for u16 {
-    const SIZE: usize = 2;
-    #[inline(always)]
-    fn from_le(b: &[u8]) -> Self {
-        u16::from_le_bytes([b[0], b[1]])
+    /// Point `i` (in file order) as [`PcdFrame::read_into`] reads it with no transform: NaN where
+    /// it is no return (a non-finite coordinate, or exactly (0, 0, 0)) or `i` is out of range.
+    #[inline]
+    pub fn point(&self, i: usize) -> Vec3 {
+        if i >= self.h.points {
+            return Vec3::NAN;
+        }
+        let (src, pos) = (self.source(), |s: Slot| self.h.slots[s as usize]);
+        let mut p = [Vec3::NAN];
+        if !src.f32_triple(pos(Slot::X), pos(Slot::Y), pos(Slot::Z), i..i + 1, &mut p) {
+            field(&src, pos(Slot::X), i..i + 1, &mut p, |o, v| o.x = v as f32);
+            field(&src, pos(Slot::Y), i..i + 1, &mut p, |o, v| o.y = v as f32);
+            field(&src, pos(Slot::Z), i..i + 1, &mut p, |o, v| o.z = v as f32);
+        }
+        let p = p[0];
+        if p.is_finite() && p != Vec3::ZERO { p } else { Vec3::NAN }
     }
-}
 
-impl Source<'_> {
-    /// Calls `set(&mut out[i], value)` for the field at `p` of every point of `points`, the value
-    /// read as `V`, where the field is binary of type `want` (true); else does nothing (false).
-    #[inline(always)]
-    fn direct<T, V: FromLe>(
+    /// The `ring` field of point `i` as [`PcdFrame::read_into`] reads it, if the file has one and
+    /// `i` is in range.
+    pub fn ring(&self, i: usize) -> Option<u16> {
+        let p = self.h.slots[Slot::Ring as usize].filter(|_| i < self.h.points)?;
+        let mut r = [0u16];
+        field(&self.source(), Some(p), i..i + 1, &mut r, |o, v| *o = v as u16);
+        Some(r[0])
+    }
+
+    /// Decodes every point into `cloud` (its buffers reused), shaped as [`PcdFrame::shape`] says.
+    /// `rows_to[k]`, where given, is the cloud row that file row `k` goes to (a permutation of the
+    /// rows of a one-plane file; refused otherwise); `transform` is applied to the points (returns
+    /// only) and normals as they are read, in the operations of
+    /// [`crate::cloud::transform_returns`]. On an error `cloud` is unchanged.
+    pub fn read_into(
         &self,
-        p: Option<FieldPos>,
-        want: Scalar,
-        points: std::ops::Range<usize>,
-        out: &mut [T],
-        mut set: impl FnMut(&mut T, V),
-    ) -> bool {
-        let (Source::Binary { body, record }, Some(p)) = (self, p) else { return false };
-        if p.scalar != want || want.size() != V::SIZE || p.offset + V::SIZE > *record {
-            return false;
-        }
-        let recs = body[points.start * record..points.end * record].chunks_exact(*record);
-        for (r, o) in recs.zip(out) {
-            set(o, V::from_le(&r[p.offset..]));
-        }
-        true
-    }
-
-    /// The points of `points` from three `float32` fields `x`, `y`, `z` of binary records, read
-    /// together (one pass over the records instead of three); false where the fields are not all
-    /// binary `float32` (then nothing is written).
-    #[inline(always)]
-    fn f32_triple(
-        &self,
-        x: Option<FieldPos>,
-        y: Option<FieldPos>,
-        z: Option<FieldPos>,
-        points: std::ops::Range<usize>,
-        out: &mut [Vec3],
-    ) -> bool {
-        let (Source::Binary { body, record }, Some(x), Some(y), Some(z)) = (self, x, y, z) else { return false };
-        if [x, y, z].iter().any(|p| p.scalar != Scalar::F(4) || p.offset + 4 > *record) {
-            return false;
-        }
-        let f = |r: &[u8], at: usize| f32::from_le(&r[at..at + 4]);
-        for (r, o) in body[points.start * record..points.end * record].chunks_exact(*record).zip(out) {
-            *o = Vec3::new(f(r, x.offset), f(r, y.offset), f(r, z.offset));
-        }
-        true
-    }
-
-    /// Calls `set(&mut out[i], value)` for the field at `p` of every point of `points` (`out` holds
-    /// their slots, in order); the field's type is matched once, outside the loop, and records and
-    /// slots are zipped (no index checks).
-    #[inline(always)]
-    fn each<T>(&self, p: FieldPos, points: std::ops::Range<usize>, out: &mut [T], mut set: impl FnMut(&mut T, f64)) {
-        match self {
-            Source::Ascii { values, tokens } => {
-                for (i, o) in points.zip(out) {
-                    set(o, values[i * tokens + p.token]);
-                }
-            }
-            Source::Binary { body, record } => {
-                let record = (*record).max(1);
-                let recs = body[points.start * record..points.end * record].chunks_exact(record);
-                let at = p.offset;
-                match p.scalar {
-                    Scalar::F(4) => recs
-                        .zip(out)
-                        .for_each(|(r, o)| set(o, le4(r, at).map_or(f64::NAN, |b| f64::from(f32::from_le_bytes(b))))),
-                    Scalar::U(4) => recs
-                        .zip(out)
-                        .for_each(|(r, o)| set(o, le4(r, at).map_or(f64::NAN, |b| f64::from(u32::from_le_bytes(b))))),
-                    Scalar::U(2) => recs.zip(out).for_each(|(r, o)| {
-                        set(o, r.get(at..at + 2).map_or(f64::NAN, |x| f64::from(u16::from_le_bytes([x[0], x[1]]))))
-                    }),
-                    s => recs.zip(out).for_each(|(r, o)| set(o, decode_le(s, r.get(at..).unwrap_or(&[])))),
-                }
+        cloud: &mut OrderedCloud,
+        rows_to: Option<&[usize]>,
+        transform: Affine3A,
+    ) -> Result<PcdInfo> {
+        let (rows, cols, planes) = self.shape();
+        if let Some(to) = rows_to {
+            let mut seen = vec![false; rows];
+            let permutation = planes == 1
+                && to.len() == rows
+                && to.iter().all(|&d| d < rows && !std::mem::replace(&mut seen[d], true));
+            if !permutation {
+                return Err(SimError::bad_file(
+                    self.path,
+                    format!("rows_to must be a permutation of the {rows} rows of a one-plane file, got {to:?}"),
+                ));
             }
         }
-    }
-}
-
-/// [`Source::each`] for the field at `p`, if the file has it.
-#[inline(always)]
-fn field<T>(
-    src: &Source<'_>,
-    p: Option<FieldPos>,
-    points: std::ops::Range<usize>,
-    out: &mut [T],
-    set: impl FnMut(&mut T, f64),
-) {
-    if let Some(p) = p {
-        src.each(p, points, out, set);
-    }
-}
-
-/// The 4 bytes at `at` of record `r`, if it holds them.
-#[inline(always)]
-fn le4(r: &[u8], at: usize) -> Option<[u8; 4]> {
-    r.get(at..at + 4).map(|x| [x[0], x[1], x[2], x[3]])
-}
-
-/// The values of ASCII `lines`, `tokens` a line (the tokens of `needed` parsed, the others NaN),
-/// refused with the point and token named.
-fn parse_ascii(lines: &[&[u8]], tokens: usize, needed: &[bool], bad: impl Fn(String) -> SimError) -> Result<Vec<f64>> {
-    let mut values = Vec::with_capacity(lines.len() * tokens);
-    let mut line_tokens: Vec<&str> = Vec::with_capacity(tokens);
-    for (i, raw) in lines.iter().enumerate() {
-        let line = std::str::from_utf8(raw).map_err(|_| bad(format!("PCD ASCII point {i} is not text")))?;
-        line_tokens.clear();
-        line_tokens.extend(line.split_whitespace());
-        if line_tokens.len() != tokens {
-            return Err(bad(format!("PCD ASCII point {i} has {} values, header needs {tokens}", line_tokens.len())));
+        let src = self.source();
+        let mut decoder = Decoder::start(&self.h, self.info(), (rows, cols, planes), rows_to, transform, cloud);
+        match rows_to {
+            Some(to) => {
+                for (k, &d) in to.iter().enumerate() {
+                    decoder.decode(&src, k * cols..(k + 1) * cols, d * cols, cloud);
+                }
+            }
+            None => decoder.decode(&src, 0..self.h.points, 0, cloud),
         }
-        for (t, &need) in line_tokens.iter().zip(needed) {
-            values.push(if need {
-                t.parse::<f64>().map_err(|_| bad(format!("PCD ASCII point {i}: `{t}` is not a number")))?
-            } else {
-                f64::NAN
-            });
+        Ok(decoder.info)
+    }
+
+    /// The data as the decoder reads it.
+    fn source(&self) -> Source<'_> {
+        let record = self.h.record_bytes;
+        match &self.data {
+            Data::Binary(body) => Source::Binary { body, record },
+            Data::Decompressed(records) => Source::Binary { body: records, record },
+            Data::Ascii(values) => Source::Ascii { values, tokens: self.h.tokens },
         }
     }
-    Ok(values)
 }
 
-/// One little-endian value from the start of `b`, widened to `f64` (NaN if `b` is too short): the
-/// binary reader's inlined form of `Scalar::decode`.
-#[inline(always)]
-fn decode_le(s: Scalar, b: &[u8]) -> f64 {
-    let take4 = |b: &[u8]| b.get(..4).map(|x| [x[0], x[1], x[2], x[3]]);
-    match s {
-        Scalar::F(4) => take4(b).map_or(f64::NAN, |x| f64::from(f32::from_le_bytes(x))),
-        Scalar::U(4) => take4(b).map_or(f64::NAN, |x| f64::from(u32::from_le_bytes(x))),
-        Scalar::I(4) => take4(b).map_or(f64::NAN, |x| f64::from(i32::from_le_bytes(x))),
-        Scalar::U(2) => b.get(..2).map_or(f64::NAN, |x| f64::from(u16::from_le_bytes([x[0], x[1]]))),
-        Scalar::I(2) => b.get(..2).map_or(f64::NAN, |x| f64::from(i16::from_le_bytes([x[0], x[1]]))),
-        Scalar::U(1) => b.first().map_or(f64::NAN, |&x| f64::from(x)),
-        Scalar::I(1) => b.first().map_or(f64::NAN, |&x| f64::from(x as i8)),
-        other => other.decode(b, false).unwrap_or(f64::NAN),
+/// Refuses binary data of `data_bytes` that do not hold exactly the header's points.
+fn check_binary_size(path: &Path, h: &Header, data_bytes: usize) -> Result<()> {
+    let bad = |m: String| SimError::bad_file(path, m);
+    let need = h.points.checked_mul(h.record_bytes).ok_or_else(|| bad("PCD: data size overflows".into()))?;
+    if data_bytes != need {
+        return Err(bad(format!(
+            "PCD header declares {} points of {} bytes ({need} bytes) but the file holds {data_bytes} data bytes",
+            h.points, h.record_bytes
+        )));
     }
+    Ok(())
 }
