@@ -36,11 +36,11 @@ fn polar_avx2(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Ve
 #[inline(always)]
 fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     let m = valid.map_or(points.len(), <[u32]>::len);
-    let (mut az, mut dist, mut fine) = (vec![0.0f32; m], vec![0.0f32; m], vec![0.0f32; m]);
-    let outputs = az.chunks_mut(LANES).zip(dist.chunks_mut(LANES).zip(fine.chunks_mut(LANES)));
-    for (j, (a, (d, f))) in outputs.enumerate() {
+    // Filled lane block by lane block (not zeroed first: that `memset` cost 0.1 ms a KITTI frame).
+    let (mut az, mut dist, mut fine) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::with_capacity(m));
+    for j in 0..m.div_ceil(LANES) {
         let (mut x, mut y, mut z) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
-        let n = a.len();
+        let n = LANES.min(m - j * LANES);
         match valid {
             Some(valid) => {
                 for (l, &k) in valid[j * LANES..j * LANES + n].iter().enumerate() {
@@ -60,9 +60,9 @@ fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Ve
             od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
             of[l] = z[l] / od[l].max(1e-6);
         }
-        a.copy_from_slice(&oa[..n]);
-        d.copy_from_slice(&od[..n]);
-        f.copy_from_slice(&of[..n]);
+        az.extend_from_slice(&oa[..n]);
+        dist.extend_from_slice(&od[..n]);
+        fine.extend_from_slice(&of[..n]);
     }
     (az, dist, fine)
 }
