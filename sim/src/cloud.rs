@@ -206,3 +206,27 @@ pub fn transform_returns(vehicle_from_sensor: glam::Affine3A, points: &mut [glam
         *p = if p.is_finite() { q } else { *p };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::{Affine3A, Vec3};
+
+    #[test]
+    fn transform_returns_gives_transform_point3_bits_and_keeps_no_returns() {
+        let t = Affine3A::from_rotation_z(0.7)
+            * Affine3A::from_rotation_x(-0.1)
+            * Affine3A::from_translation(Vec3::new(1.3, -0.2, 1.85));
+        let mut points: Vec<Vec3> = (0..1000)
+            .map(|i| Vec3::new(i as f32 * 0.37 - 150.0, (i % 17) as f32 * -2.1, (i % 5) as f32 * 0.3 - 0.7))
+            .collect();
+        points[3] = Vec3::NAN;
+        points[7] = Vec3::new(1.0, f32::INFINITY, 0.0);
+        let before = points.clone();
+        super::transform_returns(t, &mut points);
+        for (k, (p, q)) in before.iter().zip(&points).enumerate() {
+            let want = if p.is_finite() { t.transform_point3(*p) } else { *p };
+            let bits = |v: &Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+            assert_eq!(bits(q), bits(&want), "point {k}");
+        }
+    }
+}
