@@ -221,7 +221,7 @@ impl FrameReader {
     }
 
     /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
-    /// ordering).
+    /// ordering; for a driver's organized PCD, decoded in order, only the mapping and the header).
     pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> anyhow::Result<f64> {
         let t0 = std::time::Instant::now();
         self.ordered = false;

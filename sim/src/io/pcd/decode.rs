@@ -54,12 +54,16 @@ impl Decoder {
         }
         // Defaults row by row (a division per point cost 1.5 ms a frame).
         if !has(Slot::Ring) {
-            for (k, rg) in cloud.ring.chunks_mut(cols1).enumerate() {
-                rg.fill((k % rows1) as u16);
-            }
-            if let Some(to) = rows_to {
-                for (k, &d) in to.iter().enumerate() {
-                    cloud.ring[d * cols..(d + 1) * cols].fill(k as u16);
+            match rows_to {
+                Some(to) => {
+                    for (k, &d) in to.iter().enumerate() {
+                        cloud.ring[d * cols..(d + 1) * cols].fill(k as u16);
+                    }
+                }
+                None => {
+                    for (k, rg) in cloud.ring.chunks_mut(cols1).enumerate() {
+                        rg.fill((k % rows1) as u16);
+                    }
                 }
             }
         }

@@ -113,12 +113,8 @@ impl<'a> PcdFrame<'a> {
                 check_binary_size(path, &h, body.len())?;
                 Data::Binary(body)
             }
-            // Checked against the header while decompressing, and again here.
-            DataKind::Compressed => {
-                let records = decompress_fields(path, &h, body)?;
-                check_binary_size(path, &h, records.len())?;
-                Data::Decompressed(records)
-            }
+            // Checked against the header while decompressing.
+            DataKind::Compressed => Data::Decompressed(decompress_fields(path, &h, body)?),
             DataKind::Ascii => {
                 let lines: Vec<&[u8]> =
                     body.split(|&b| b == b'\n').filter(|l| l.iter().any(|b| !b.is_ascii_whitespace())).collect();
