@@ -105,40 +105,83 @@ pub(super) fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &
 /// Cells of the fast path that lack a direct neighbour, gathered from many blocks so that their
 /// features ([`lane_features`]) run `L` at a time instead of once per block for a few lanes (real
 /// recordings leave empty cells scattered over every ring: half the blocks have one).
+///
+/// A queued cell keeps only its neighbours' indices; the offsets and tests run lane-wise when the
+/// queue is computed ([`gather_lanes`]), with the operations of [`fill_one`] but selects instead of
+/// branches per neighbour (measured on KITTI frames: features 4.0 -> 3.7 ms, min of 6 x 20 side by side).
 pub(super) struct GeneralQueue {
     lanes: Lanes,
-    /// Cell index and whether it has a return, per queued lane.
-    cells: [(usize, bool); L],
+    /// Neighbour cell indices per neighbour and lane (the cell itself where missing).
+    nb: [[u32; L]; 8],
+    /// Cell index per queued lane.
+    cell: [u32; L],
     len: usize,
 }
 
 impl GeneralQueue {
     pub(super) fn new() -> Self {
-        Self { lanes: Lanes::default(), cells: [(0, false); L], len: 0 }
+        Self { lanes: Lanes::default(), nb: [[0; L]; 8], cell: [0; L], len: 0 }
     }
 
     /// Queues cell `(r, c)`; computes and writes the queue when it is full.
     #[inline(always)]
     pub(super) fn push(&mut self, plane: &Plane<'_>, r: usize, c: usize, out: &mut Outputs<'_>) {
-        let ok = fill_one(plane, r, c, self.len, &mut self.lanes);
-        self.cells[self.len] = (r * plane.view.cols + c, ok);
+        let i = r * plane.view.cols + c;
+        let nb = plane.search.neighbours_or(plane.view, r, c, i);
+        for k in 0..8 {
+            self.nb[k][self.len] = nb[k] as u32;
+        }
+        self.cell[self.len] = i as u32;
         self.len += 1;
         if self.len == L {
             self.flush(plane, out);
         }
     }
 
-    /// Computes the queued cells' features and writes them (stale lanes past `len` are ignored).
+    /// Computes the queued cells' features and writes them (stale lanes past `len` are computed
+    /// from the indices left there, which are cells of the plane, and ignored).
     #[inline(always)]
     pub(super) fn flush(&mut self, plane: &Plane<'_>, out: &mut Outputs<'_>) {
         if self.len == 0 {
             return;
         }
+        gather_lanes(plane, &self.cell, &self.nb, &mut self.lanes);
         let mut g = Cells::default();
         lane_features(&self.lanes, plane.min_pairs, &mut g);
-        for (l, &(i, ok)) in self.cells[..self.len].iter().enumerate() {
-            out.write_one(i, ok, &g, l);
+        for (l, &i) in self.cell[..self.len].iter().enumerate() {
+            let i = i as usize;
+            out.write_one(i, plane.valid[i], &g, l);
         }
         self.len = 0;
+    }
+}
+
+/// [`fill_one`]'s lanes for the cells `cell` with neighbours `nb` (per neighbour and lane),
+/// lane-wise: the same operations, with selects for the tests.
+#[inline(always)]
+fn gather_lanes(plane: &Plane<'_>, cell: &[u32; L], nb: &[[u32; L]; 8], lanes: &mut Lanes) {
+    // Every index is a cell of the plane: the clamp to the last cell changes none of them and
+    // lets the loads go without bounds checks (the gathers then vectorize).
+    let last = plane.x.len() - 1;
+    let (x, y, z, ranges) = (&plane.x[..=last], &plane.y[..=last], &plane.z[..=last], &plane.view.ranges[..=last]);
+    let (mut px, mut py, mut pz, mut pr) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+    for l in 0..L {
+        let i = (cell[l] as usize).min(last);
+        (px[l], py[l], pz[l], pr[l]) = (x[i], y[i], z[i], ranges[i]);
+    }
+    for k in 0..8 {
+        let (mut qx, mut qy, mut qz, mut qr) = ([0f32; L], [0f32; L], [0f32; L], [0f32; L]);
+        for l in 0..L {
+            let j = (nb[k][l] as usize).min(last);
+            (qx[l], qy[l], qz[l], qr[l]) = (x[j], y[j], z[j], ranges[j]);
+        }
+        for l in 0..L {
+            let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
+            let keep = plane.tests.keep(k, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], qr[l], pr[l]);
+            let d = if keep { d } else { [0.0; 3] };
+            (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
+            lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
+            lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        }
     }
 }
