@@ -71,10 +71,7 @@ fn direct_lanes(plane: &Plane<'_>, r: usize, c0: usize, m: usize, lanes: &mut La
             // The operations of `fill_one`: a dropped or missing neighbour gets zeros.
             let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
             let keep = exists[wr] & plane.tests.keep(k, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], qr[l], pr[l]);
-            let d = if keep { d } else { [0.0; 3] };
-            (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
-            lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
-            lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            lanes.set(k, l, d, keep);
         }
     }
     direct
@@ -94,10 +91,7 @@ pub(super) fn fill_one(plane: &Plane<'_>, r: usize, c: usize, l: usize, lanes: &
     for (k, j) in nb.into_iter().enumerate() {
         let d = [plane.x[j] - px, plane.y[j] - py, plane.z[j] - pz];
         let keep = tests.keep(k, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], ranges[j], pr);
-        let d = if keep { d } else { [0.0; 3] };
-        (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
-        lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
-        lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        lanes.set(k, l, d, keep);
     }
     plane.valid[i]
 }
@@ -178,10 +172,7 @@ fn gather_lanes(plane: &Plane<'_>, cell: &[u32; L], nb: &[[u32; L]; 8], lanes: &
         for l in 0..L {
             let d = [qx[l] - px[l], qy[l] - py[l], qz[l] - pz[l]];
             let keep = plane.tests.keep(k, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], qr[l], pr[l]);
-            let d = if keep { d } else { [0.0; 3] };
-            (lanes.dx[k][l], lanes.dy[k][l], lanes.dz[k][l]) = (d[0], d[1], d[2]);
-            lanes.ok[k][l] = if keep { 1.0 } else { 0.0 };
-            lanes.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            lanes.set(k, l, d, keep);
         }
     }
 }

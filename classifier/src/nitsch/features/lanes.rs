@@ -17,6 +17,17 @@ pub(super) struct Lanes {
     pub(super) len: [[f32; L]; 8],
 }
 
+impl Lanes {
+    /// Sets neighbour `k` of lane `l` from its offset `d`: zeros where it is not kept (`ok` 0).
+    #[inline(always)]
+    pub(super) fn set(&mut self, k: usize, l: usize, d: [f32; 3], keep: bool) {
+        let d = if keep { d } else { [0.0; 3] };
+        (self.dx[k][l], self.dy[k][l], self.dz[k][l]) = (d[0], d[1], d[2]);
+        self.ok[k][l] = if keep { 1.0 } else { 0.0 };
+        self.len[k][l] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    }
+}
+
 /// Per-lane sums over a cell's pairs: Eq. 2's weighted normal sum, the sum of the unit pair normals
 /// (Eq. 3) and the number of pairs.
 #[derive(Default)]
