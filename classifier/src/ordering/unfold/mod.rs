@@ -80,6 +80,22 @@ fn wrap_once(x: f32, period: f32) -> f32 {
     if x >= period { x - period } else { x }
 }
 
+/// Most values [`sampled_median`] selects from. A ring's points lie on one cone (their elevations
+/// spread only where a near point's beam origin differs from the sensor's), so the median of 512
+/// evenly spaced ones is the whole ring's to far less than a beam gap, which is all the row match
+/// and the direction test need (the same rows and decisions on every test and reference file;
+/// KITTI frames: ordering 2.69 -> 2.54 ms, min of 6 x 20 side by side).
+const MEDIAN_SAMPLES: usize = 512;
+
+/// The median of at most [`MEDIAN_SAMPLES`] evenly spaced values of `v` (every value of a shorter
+/// slice), selected in `scratch`.
+fn sampled_median(v: &[f32], scratch: &mut Vec<f32>) -> f32 {
+    let stride = v.len().div_ceil(MEDIAN_SAMPLES).max(1);
+    scratch.clear();
+    scratch.extend(v.iter().step_by(stride));
+    median(scratch)
+}
+
 fn median(v: &mut [f32]) -> f32 {
     if v.is_empty() {
         return f32::NAN;
@@ -172,8 +188,8 @@ pub(crate) fn unfold(
     }
     let (mut bounds, dir) = ring_starts(&az, &dist, &fine, rows, params)?;
     bounds.push(usable.len());
-    // The rings' medians, selected in place (the elevations are not needed after this).
-    let medians: Vec<f32> = bounds.windows(2).map(|w| median(&mut fine[w[0]..w[1]])).collect();
+    let mut scratch = Vec::with_capacity(MEDIAN_SAMPLES);
+    let medians: Vec<f32> = bounds.windows(2).map(|w| sampled_median(&fine[w[0]..w[1]], &mut scratch)).collect();
     let row_of_ring = match_rows(&medians, rows, params)?;
     report.rings_found = bounds.len() - 1;
     if !rows.full_turn {
@@ -196,4 +212,26 @@ pub(crate) fn unfold(
         })
         .collect();
     Ok(Unfolded::Rings { bounds, row_of_ring, column, spans_turn })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ring of 2,000 `tan(elevation)` values about 0.1 whose first 600 points (near points at the
+    /// start of the turn) lie 0.05 above: the sampled median is the whole ring's to within 1e-4, far
+    /// less than the HDL-64E's smallest beam gap (0.0058), and exact for a short slice.
+    #[test]
+    fn sampled_median_is_the_rings_median() {
+        let ring: Vec<f32> =
+            (0..2_000).map(|i| if i < 600 { 0.15 } else { 0.1 + ((i * 37) % 101) as f32 * 1e-6 - 5e-5 }).collect();
+        let mut scratch = Vec::new();
+        let exact = median(&mut ring.clone());
+        let sampled = sampled_median(&ring, &mut scratch);
+        assert!(scratch.len() <= MEDIAN_SAMPLES && scratch.len() >= MEDIAN_SAMPLES / 2);
+        assert!((sampled - exact).abs() < 1e-4, "sampled {sampled}, exact {exact}");
+        assert!((sampled - 0.1).abs() < 1e-4);
+        let short = &ring[500..900];
+        assert_eq!(sampled_median(short, &mut scratch), median(&mut short.to_vec()));
+    }
 }

@@ -9,7 +9,7 @@
 use std::f32::consts::{PI, TAU};
 
 use super::super::beam_table::{TableRows, wrap_into};
-use super::{UnfoldParams, median, wrap_once};
+use super::{MEDIAN_SAMPLES, UnfoldParams, median, sampled_median, wrap_once};
 
 /// Flag of a point in the cut window.
 const IN_WINDOW: u8 = 1;
@@ -141,9 +141,8 @@ pub(crate) fn ring_starts(
     let drop = |j: usize| flags[j] & DROP != 0;
     // Which way the rings go in elevation: compare the first and last 1/8 of the points.
     let m = (n / 8).max(1);
-    let mut head: Vec<f32> = fine[..m].to_vec();
-    let mut tail: Vec<f32> = fine[n - m..].to_vec();
-    let down = median(&mut head) >= median(&mut tail);
+    let mut scratch = Vec::with_capacity(MEDIAN_SAMPLES);
+    let down = sampled_median(&fine[..m], &mut scratch) >= sampled_median(&fine[n - m..], &mut scratch);
     let min_gap = rows.tan_elevation.windows(2).map(|w| w[1] - w[0]).fold(f32::INFINITY, f32::min);
     let mut starts = vec![0usize];
     // The file's first points are the first ring's, window or not.
