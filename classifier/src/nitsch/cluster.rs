@@ -256,15 +256,42 @@ pub fn cluster_candidates_with(
     params: &ClusterParams,
     ws: &mut ClusterWorkspace,
 ) {
+    cluster_dispatch(view, valid, None, candidate, normal, params, ws);
+}
+
+/// [`cluster_candidates_with`] with the neighbour-search tables of `valid` already built (the
+/// features' own: same grid, same returns), so that they are not built twice per frame.
+pub(crate) fn cluster_candidates_searched(
+    view: &GridView<'_>,
+    valid: &[bool],
+    search: &RowReturns,
+    candidate: &[bool],
+    normal: &[Vec3],
+    params: &ClusterParams,
+    ws: &mut ClusterWorkspace,
+) {
+    cluster_dispatch(view, Some(valid), Some(search), candidate, normal, params, ws);
+}
+
+/// Runs [`cluster_body`] as the AVX2 build where the CPU has it.
+fn cluster_dispatch(
+    view: &GridView<'_>,
+    valid: Option<&[bool]>,
+    search: Option<&RowReturns>,
+    candidate: &[bool],
+    normal: &[Vec3],
+    params: &ClusterParams,
+    ws: &mut ClusterWorkspace,
+) {
     #[cfg(target_arch = "x86_64")]
     if avx2_bmi() {
         // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
         #[allow(unsafe_code)]
         unsafe {
-            return cluster_avx2(view, valid, candidate, normal, params, ws);
+            return cluster_avx2(view, valid, search, candidate, normal, params, ws);
         }
     }
-    cluster_body(view, valid, candidate, normal, params, ws);
+    cluster_body(view, valid, search, candidate, normal, params, ws);
 }
 
 /// Whether the CPU runs the code compiled for AVX2, BMI1 and BMI2.
@@ -281,19 +308,22 @@ fn avx2_bmi() -> bool {
 fn cluster_avx2(
     view: &GridView<'_>,
     valid: Option<&[bool]>,
+    search: Option<&RowReturns>,
     candidate: &[bool],
     normal: &[Vec3],
     params: &ClusterParams,
     ws: &mut ClusterWorkspace,
 ) {
-    cluster_body(view, valid, candidate, normal, params, ws);
+    cluster_body(view, valid, search, candidate, normal, params, ws);
 }
 
-/// The body of [`cluster_candidates_with`], inlined into each instruction-set variant.
+/// The body of [`cluster_candidates_with`], inlined into each instruction-set variant; `search`:
+/// the tables of the cells' returns where the caller has them (built here otherwise).
 #[inline(always)]
 fn cluster_body(
     view: &GridView<'_>,
     valid: Option<&[bool]>,
+    search: Option<&RowReturns>,
     candidate: &[bool],
     normal: &[Vec3],
     params: &ClusterParams,
@@ -323,7 +353,13 @@ fn cluster_body(
         }
     }
     ws.returns = ws.valid.iter().map(|&v| usize::from(v)).sum();
-    ws.search.build(view, &ws.valid[..n]);
+    let search = match search {
+        Some(search) => search,
+        None => {
+            ws.search.build(view, &ws.valid[..n]);
+            &ws.search
+        }
+    };
     // Only cells with a return can be candidates: the members, each its own root to begin with.
     ws.parent.clear();
     ws.parent.resize(n, NONE);
@@ -404,7 +440,7 @@ fn cluster_body(
                 }
             } else {
                 // A missing neighbour is the cell itself, which never links to itself.
-                for j in ws.search.neighbours_or(view, r, c, i) {
+                for j in search.neighbours_or(view, r, c, i) {
                     if parent[j] != NONE {
                         // The unions above may have moved this cell's root.
                         ri = find(parent, ri);

@@ -139,6 +139,11 @@ impl Features {
         &self.soa.valid[..self.g_rho.len()]
     }
 
+    /// The neighbour-search tables of the last computed plane's returns (for the clustering).
+    pub(crate) fn search(&self) -> &RowReturns {
+        &self.soa.search
+    }
+
     /// Resizes the buffers to `n` cells (no reallocation when the size is unchanged).
     fn resize(&mut self, n: usize) {
         self.normal.resize(n, Vec3::ZERO);

@@ -16,7 +16,7 @@ mod row_returns;
 use glam::Vec3;
 
 use crate::error::{ClassifyError, Result, check_cloud, is_valid};
-use crate::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_with};
+use crate::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_searched};
 use crate::nitsch::features::{FeatureParams, Features, compute_features};
 use crate::nitsch::neighbours::{GridView, NeighbourParams, Wrap, detect_wrap};
 
@@ -188,9 +188,10 @@ impl Nitsch {
         if self.params.cluster {
             self.candidate.clear();
             self.candidate.extend(self.features.g_rho.iter().map(|&g| g >= thr && g > 0.0));
-            cluster_candidates_with(
+            cluster_candidates_searched(
                 view,
-                Some(self.features.valid()),
+                self.features.valid(),
+                self.features.search(),
                 &self.candidate,
                 &self.features.normal,
                 &self.params.clustering,

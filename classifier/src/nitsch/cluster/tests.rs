@@ -126,8 +126,14 @@ fn grid_order_clustering_equals_the_per_cell_definition() {
             // The portable variant too (the dispatcher above may have picked AVX2), and the
             // rules of both.
             let mut portable = ClusterWorkspace::default();
-            cluster_body(&view, None, &candidate, &nitsch.features.normal, &params.clustering, &mut portable);
+            cluster_body(&view, None, None, &candidate, &nitsch.features.normal, &params.clustering, &mut portable);
             assert_eq!(portable.parent, fast.parent);
+            // With the features' own search tables, as the classifier runs it.
+            let mut searched = ClusterWorkspace::default();
+            let (valid, search) = (nitsch.features.valid(), nitsch.features.search());
+            let normal = &nitsch.features.normal;
+            cluster_candidates_searched(&view, valid, search, &candidate, normal, &params.clustering, &mut searched);
+            assert_eq!(searched.parent, fast.parent);
             let (mut ground, mut ground_portable) = (vec![false; cloud.len()], vec![false; cloud.len()]);
             fast.decide(view.points, fast.returns(), &params.clustering, &mut ground);
             portable.decide_body(view.points, portable.returns(), &params.clustering, &mut ground_portable);
