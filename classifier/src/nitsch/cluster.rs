@@ -256,7 +256,7 @@ pub fn cluster_candidates_with(
     params: &ClusterParams,
     ws: &mut ClusterWorkspace,
 ) {
-    cluster_dispatch(view, valid, None, candidate, normal, params, ws);
+    cluster_dispatch(Inputs { view, valid, search: None, candidate, normal }, params, ws);
 }
 
 /// [`cluster_candidates_with`] with the neighbour-search tables of `valid` already built (the
@@ -270,28 +270,32 @@ pub(crate) fn cluster_candidates_searched(
     params: &ClusterParams,
     ws: &mut ClusterWorkspace,
 ) {
-    cluster_dispatch(view, Some(valid), Some(search), candidate, normal, params, ws);
+    cluster_dispatch(Inputs { view, valid: Some(valid), search: Some(search), candidate, normal }, params, ws);
+}
+
+/// What the clustering reads: the grid, which cells hold returns (found from the points where
+/// `None`), the neighbour-search tables of those returns (built here where `None`), the
+/// candidates and their normals.
+#[derive(Clone, Copy)]
+struct Inputs<'a> {
+    view: &'a GridView<'a>,
+    valid: Option<&'a [bool]>,
+    search: Option<&'a RowReturns>,
+    candidate: &'a [bool],
+    normal: &'a [Vec3],
 }
 
 /// Runs [`cluster_body`] as the AVX2 build where the CPU has it.
-fn cluster_dispatch(
-    view: &GridView<'_>,
-    valid: Option<&[bool]>,
-    search: Option<&RowReturns>,
-    candidate: &[bool],
-    normal: &[Vec3],
-    params: &ClusterParams,
-    ws: &mut ClusterWorkspace,
-) {
+fn cluster_dispatch(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWorkspace) {
     #[cfg(target_arch = "x86_64")]
     if avx2_bmi() {
         // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
         #[allow(unsafe_code)]
         unsafe {
-            return cluster_avx2(view, valid, search, candidate, normal, params, ws);
+            return cluster_avx2(inputs, params, ws);
         }
     }
-    cluster_body(view, valid, search, candidate, normal, params, ws);
+    cluster_body(inputs, params, ws);
 }
 
 /// Whether the CPU runs the code compiled for AVX2, BMI1 and BMI2.
@@ -305,30 +309,14 @@ fn avx2_bmi() -> bool {
 /// [`cluster_body`] compiled for AVX2, BMI1 and BMI2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,bmi2")]
-fn cluster_avx2(
-    view: &GridView<'_>,
-    valid: Option<&[bool]>,
-    search: Option<&RowReturns>,
-    candidate: &[bool],
-    normal: &[Vec3],
-    params: &ClusterParams,
-    ws: &mut ClusterWorkspace,
-) {
-    cluster_body(view, valid, search, candidate, normal, params, ws);
+fn cluster_avx2(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWorkspace) {
+    cluster_body(inputs, params, ws);
 }
 
-/// The body of [`cluster_candidates_with`], inlined into each instruction-set variant; `search`:
-/// the tables of the cells' returns where the caller has them (built here otherwise).
+/// The body of [`cluster_candidates_with`], inlined into each instruction-set variant.
 #[inline(always)]
-fn cluster_body(
-    view: &GridView<'_>,
-    valid: Option<&[bool]>,
-    search: Option<&RowReturns>,
-    candidate: &[bool],
-    normal: &[Vec3],
-    params: &ClusterParams,
-    ws: &mut ClusterWorkspace,
-) {
+fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWorkspace) {
+    let Inputs { view, valid, search, candidate, normal } = inputs;
     let (rows, cols) = (view.rows, view.cols);
     let n = rows * cols;
     let points = &view.points[..n];

@@ -126,7 +126,14 @@ fn grid_order_clustering_equals_the_per_cell_definition() {
             // The portable variant too (the dispatcher above may have picked AVX2), and the
             // rules of both.
             let mut portable = ClusterWorkspace::default();
-            cluster_body(&view, None, None, &candidate, &nitsch.features.normal, &params.clustering, &mut portable);
+            let inputs = Inputs {
+                view: &view,
+                valid: None,
+                search: None,
+                candidate: &candidate,
+                normal: &nitsch.features.normal,
+            };
+            cluster_body(inputs, &params.clustering, &mut portable);
             assert_eq!(portable.parent, fast.parent);
             // With the features' own search tables, as the classifier runs it.
             let mut searched = ClusterWorkspace::default();
