@@ -171,7 +171,7 @@ pub struct ClusterWorkspace {
     near: Vec<(f32, u32)>,
     /// Decision per root.
     root_ground: Vec<bool>,
-    /// Whether each cell holds a return.
+    /// Whether each cell holds a return, where the caller does not give the flags.
     valid: Vec<bool>,
     /// Per column of the row being clustered: returns in the rows below, at and above.
     column_valid: Vec<bool>,
@@ -330,21 +330,23 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
         ws.size.clear();
         ws.size.resize(n, 0);
     }
-    ws.valid.resize(n, false);
-    match valid {
-        Some(valid) => ws.valid.copy_from_slice(&valid[..n]),
+    // The caller's flags where it has them (no copy), else found from the points.
+    let valid = match valid {
+        Some(valid) => &valid[..n],
         None => {
+            ws.valid.resize(n, false);
             for (v, p) in ws.valid.iter_mut().zip(points) {
                 // `is_valid` without short-circuit branches, so that it vectorizes.
                 *v = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
             }
+            &ws.valid[..n]
         }
-    }
-    ws.returns = ws.valid.iter().map(|&v| usize::from(v)).sum();
+    };
+    ws.returns = valid.iter().map(|&v| usize::from(v)).sum();
     let search = match search {
         Some(search) => search,
         None => {
-            ws.search.build(view, &ws.valid[..n]);
+            ws.search.build(view, valid);
             &ws.search
         }
     };
@@ -355,7 +357,7 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
     // cells a bit mask (8 cells per multiplication, [`pack8`]), whose set bits are then listed:
     // a step per member, none per cell.
     ws.members.clear();
-    for (k, (cand, valid)) in candidate[..n].chunks(64).zip(ws.valid[..n].chunks(64)).enumerate() {
+    for (k, (cand, valid)) in candidate[..n].chunks(64).zip(valid.chunks(64)).enumerate() {
         let mut mask = 0u64;
         if cand.len() == 64 {
             for (b, (c, v)) in cand.chunks_exact(8).zip(valid.chunks_exact(8)).enumerate() {
@@ -383,7 +385,7 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
         let row = r * cols..(r + 1) * cols;
         let interior_row = r > 0 && r + 1 < rows;
         if interior_row {
-            let (below, at, above) = (&ws.valid[row.start - cols..], &ws.valid[row.clone()], &ws.valid[row.end..]);
+            let (below, at, above) = (&valid[row.start - cols..], &valid[row.clone()], &valid[row.end..]);
             for (c, v) in ws.column_valid.iter_mut().enumerate() {
                 *v = below[c] & at[c] & above[c];
             }
