@@ -192,9 +192,9 @@ impl Tests {
 /// neighbour distances from the grid squares around them, `L` cells at a time: each square's 4
 /// triangles and 3 edges are computed once and shared by the two cells that use each ([`squares`]).
 /// The others use [`GridView::neighbours`] and their own cross products. Either way every cell gets
-/// the result of the per-cell definition within 1e-5 (tested against it: the reciprocal square
-/// roots of [`rsqrt`] replace square roots and divisions, and a shared triangle's cross product is
-/// rounded as computed from one of its corners). Every instruction-set variant gives the same bits
+/// the result of the per-cell definition within 2e-6 (tested against it: [`rsqrt`] computes
+/// `1 / |n|` as `1 / sqrt(|n|^2)`, and a shared triangle's cross product is rounded as computed
+/// from one of its corners). Every instruction-set variant gives the same bits
 /// (plain IEEE operations, no fused multiply-add).
 pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     #[cfg(target_arch = "x86_64")]

@@ -127,9 +127,9 @@ fn small_and_odd_grids_equal_the_per_cell_definition() {
             let mut got = Features::default();
             compute_features(&view, &params, &mut got);
             for (i, &(n, n_rho, g_rho)) in reference(&view, &params).iter().enumerate() {
-                assert!((got.normal[i] - n).abs().max_element() <= 1e-5, "{rows} x {cols}, cell {i}");
-                assert!((got.n_rho[i] - n_rho).abs() <= 1e-5, "{rows} x {cols}, cell {i}");
-                assert!((got.g_rho[i] - g_rho).abs() <= 1e-5, "{rows} x {cols}, cell {i}");
+                assert!((got.normal[i] - n).abs().max_element() <= 2e-6, "{rows} x {cols}, cell {i}");
+                assert!((got.n_rho[i] - n_rho).abs() <= 2e-6, "{rows} x {cols}, cell {i}");
+                assert!((got.g_rho[i] - g_rho).abs() <= 2e-6, "{rows} x {cols}, cell {i}");
                 featured += usize::from(n_rho > 0.5);
             }
             cells += rows * cols;
@@ -142,7 +142,7 @@ fn small_and_odd_grids_equal_the_per_cell_definition() {
 #[test]
 fn lane_wise_features_equal_the_per_cell_definition() {
     /// Largest difference allowed in a feature (all lie in [-1, 1]).
-    const TOL: f32 = 1e-5;
+    const TOL: f32 = 2e-6;
     let (mut checked, mut worst) = (0, 0f32);
     for (drop, seed, spinning) in [(0.0, 1, true), (0.1, 2, true), (0.4, 3, true), (0.2, 4, false)] {
         let cloud = frame(drop, seed, spinning);
@@ -176,8 +176,8 @@ fn lane_wise_features_equal_the_per_cell_definition() {
             let want = reference(&view, &params);
             for (i, &(n, n_rho, g_rho)) in want.iter().enumerate() {
                 let got = (fast.normal[i], fast.n_rho[i], fast.g_rho[i]);
-                // Reciprocal square roots by Newton steps instead of sqrt and division: the
-                // same features within `TOL`, and the same cells with and without features.
+                // Shared triangles rounded as computed from one corner: the same features
+                // within `TOL` (largest seen 6e-7), and the same cells with and without features.
                 assert!(
                     (got.0 - n).abs().max_element() <= TOL,
                     "normal of cell {i}: {} vs {n} (drop {drop}, gap {gap})",
