@@ -85,10 +85,14 @@ impl RowReturns {
         self.cols < 2 * self.gap + 2
     }
 
-    /// Column `c + k` (`|k| <= gap < cols`), wrapped (selects, no branches).
+    /// Column `c + k` (`|k| <= gap < cols`), wrapped (selects, no branches) where `EDGE` (a cell
+    /// within `2 gap` columns of the grid's edges); plain `c + k` elsewhere, where it is in range.
     #[inline(always)]
-    fn col(&self, c: usize, k: isize) -> usize {
+    fn col<const EDGE: bool>(&self, c: usize, k: isize) -> usize {
         let cc = c as isize + k;
+        if !EDGE {
+            return cc as usize;
+        }
         let cols = self.cols as isize;
         let cc = if cc < 0 { cc + cols } else { cc };
         (if cc >= cols { cc - cols } else { cc }) as usize
@@ -97,23 +101,23 @@ impl RowReturns {
     /// The first return right (`step` +1) or left (-1) of column `c` in row `row`, within the gap;
     /// `missing` if none.
     #[inline(always)]
-    fn along(&self, row: usize, c: usize, step: isize, missing: usize) -> usize {
+    fn along<const EDGE: bool>(&self, row: usize, c: usize, step: isize, missing: usize) -> usize {
         let i = row * self.cols + c;
         let k = if step > 0 { self.right[i] as isize } else { -(self.left[i] as isize) };
-        let j = row * self.cols + self.col(c, k);
+        let j = row * self.cols + self.col::<EDGE>(c, k);
         if k == 0 { missing } else { j }
     }
 
     /// The centre, right and left neighbours of column `c` in row `row` (`missing` where there are
     /// none), if the row has a return near the column.
     #[inline(always)]
-    fn side(&self, row: usize, c: usize, missing: usize) -> Option<[usize; 3]> {
+    fn side<const EDGE: bool>(&self, row: usize, c: usize, missing: usize) -> Option<[usize; 3]> {
         let k = self.near[row * self.cols + c];
         if k == FAR {
             return None;
         }
-        let cc = self.col(c, k as isize);
-        Some([row * self.cols + cc, self.along(row, cc, 1, missing), self.along(row, cc, -1, missing)])
+        let cc = self.col::<EDGE>(c, k as isize);
+        Some([row * self.cols + cc, self.along::<EDGE>(row, cc, 1, missing), self.along::<EDGE>(row, cc, -1, missing)])
     }
 
     /// [`GridView::neighbours`] of cell `(r, c)` of `view` (the grid the tables were built from),
@@ -123,13 +127,26 @@ impl RowReturns {
         if self.narrow() {
             return view.neighbours(r, c).map(|j| j.unwrap_or(missing));
         }
+        // A search from a column at least `2 gap` from both edges (the centre neighbour up to `gap`
+        // away, the diagonal ones `gap` beyond it) never wraps: no wrap selects there.
+        if c >= 2 * self.gap && c + 2 * self.gap < self.cols {
+            self.search::<false>(r, c, missing)
+        } else {
+            self.search::<true>(r, c, missing)
+        }
+    }
+
+    /// [`RowReturns::neighbours_or`] on a grid wide enough for the tables, wrapping columns where
+    /// `EDGE`.
+    #[inline(always)]
+    fn search<const EDGE: bool>(&self, r: usize, c: usize, missing: usize) -> [usize; 8] {
         let mut out = [missing; 8];
-        out[2] = self.along(r, c, 1, missing);
-        out[6] = self.along(r, c, -1, missing);
+        out[2] = self.along::<EDGE>(r, c, 1, missing);
+        out[6] = self.along::<EDGE>(r, c, -1, missing);
         // The nearest row above (below) with a return near the column, skipping empty rows (plain
         // loops: iterator adaptors here were left as calls).
         for up in r + 1..self.rows.min(r + 1 + MAX_ROW_GAP) {
-            if let Some([centre, right, left]) = self.side(up, c, missing) {
+            if let Some([centre, right, left]) = self.side::<EDGE>(up, c, missing) {
                 (out[0], out[1], out[7]) = (centre, right, left);
                 break;
             }
@@ -137,7 +154,7 @@ impl RowReturns {
         let mut dn = r;
         while dn > r.saturating_sub(MAX_ROW_GAP) {
             dn -= 1;
-            if let Some([centre, right, left]) = self.side(dn, c, missing) {
+            if let Some([centre, right, left]) = self.side::<EDGE>(dn, c, missing) {
                 (out[4], out[3], out[5]) = (centre, right, left);
                 break;
             }
