@@ -29,8 +29,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use classifier::FrameInput;
 use classifier::ordering::{
-    BeamTable, Calibration, OrderingReport, PathChoice, PointAttributes, UnfoldParams, decisions_per_point,
-    order_cloud_into, read_organized_into,
+    BeamTable, Calibration, CloudBuffer, OrderingReport, PathChoice, PointAttributes, UnfoldParams,
+    decisions_per_point, order_cloud_into, read_organized_into,
 };
 use glam::{Affine3A, Mat4};
 use sim::OrderedCloud;
@@ -169,7 +169,7 @@ impl SensorSetup {
         path: &Path,
         points: &[glam::Vec3],
         attributes: &PointAttributes<'_>,
-        cloud: &mut OrderedCloud,
+        cloud: &mut CloudBuffer,
         report: &mut OrderingReport,
     ) -> anyhow::Result<()> {
         order_cloud_into(
@@ -201,7 +201,7 @@ pub(crate) struct FrameReader {
     /// A PCD as the file holds it (ordered from here where it is not organized).
     file_cloud: OrderedCloud,
     /// The cloud to classify.
-    cloud: OrderedCloud,
+    cloud: CloudBuffer,
     /// What ordering did, for input from other tools.
     report: OrderingReport,
     /// Whether `report` belongs to the last frame (input from other tools).
@@ -211,7 +211,7 @@ pub(crate) struct FrameReader {
 impl FrameReader {
     /// The last frame's cloud.
     pub fn cloud(&self) -> &OrderedCloud {
-        &self.cloud
+        self.cloud.cloud()
     }
 
     /// What ordering did with the last frame, for input from other tools (cell of every input
@@ -239,7 +239,7 @@ impl FrameReader {
                     {
                         bail!("`{}` has {rows} rows but the calibration file {n} lasers", path.display());
                     }
-                    read_organized_into(&frame, setup.vehicle_from_sensor, &mut self.cloud, &mut self.report)
+                    read_organized_into(&frame, setup.vehicle_from_sensor, self.cloud.cloud_mut(), &mut self.report)
                         .with_context(|| format!("ordering the rows of `{}`", path.display()))?;
                     self.ordered = true;
                     return Ok(read_ms);
@@ -247,7 +247,7 @@ impl FrameReader {
                 let info = frame.read_into(&mut self.file_cloud, None, Affine3A::IDENTITY)?;
                 let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                 if info.ours || self.file_cloud.planes > 1 {
-                    std::mem::swap(&mut self.cloud, &mut self.file_cloud);
+                    std::mem::swap(self.cloud.cloud_mut(), &mut self.file_cloud);
                     return Ok(read_ms);
                 }
                 // An unorganized PCD: ordered as a KITTI file is.

@@ -24,6 +24,7 @@
 //! placed.
 
 pub mod beam_table;
+mod buffer;
 pub mod calibration;
 pub mod organized;
 pub mod placement;
@@ -37,6 +38,7 @@ use glam::{Affine3A, Vec3};
 use sim::{OrderedCloud, SemanticClass};
 
 pub use beam_table::{BeamTable, TableRows};
+pub use buffer::CloudBuffer;
 pub use calibration::{Calibration, CalibrationError};
 pub use organized::{order_organized, order_organized_in_place, read_organized_into};
 pub use placement::PointAttributes;
@@ -74,7 +76,7 @@ pub fn order_cloud(
     choice: PathChoice,
     params: &UnfoldParams,
 ) -> Result<(OrderedCloud, OrderingReport)> {
-    let (mut cloud, mut report) = (OrderedCloud::default(), OrderingReport::default());
+    let (mut cloud, mut report) = (CloudBuffer::default(), OrderingReport::default());
     order_cloud_into(
         points_in_sensor,
         attributes,
@@ -85,12 +87,13 @@ pub fn order_cloud(
         &mut cloud,
         &mut report,
     )?;
-    Ok((cloud, report))
+    Ok((cloud.into_cloud(), report))
 }
 
 /// As [`order_cloud`], into `cloud` and `report`, whose buffers are reused: a sequence of frames
-/// ordered one after another allocates no cloud once they are large enough. On an error their
-/// content is not meaningful.
+/// ordered one after another allocates no cloud once they are large enough, and does not rewrite
+/// the fields it never fills ([`CloudBuffer`]). On an error `report` is not meaningful and the
+/// cloud is the previous one.
 #[allow(clippy::too_many_arguments)]
 pub fn order_cloud_into(
     points_in_sensor: &[Vec3],
@@ -99,7 +102,7 @@ pub fn order_cloud_into(
     vehicle_from_sensor: Affine3A,
     choice: PathChoice,
     params: &UnfoldParams,
-    cloud: &mut OrderedCloud,
+    cloud: &mut CloudBuffer,
     report: &mut OrderingReport,
 ) -> Result<()> {
     let rows = table.rows()?;

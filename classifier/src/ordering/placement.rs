@@ -8,8 +8,10 @@
 //! from the nearest plane-0 return (`nitsch::echoes_from_plane0`), so no point is left out.
 
 use glam::{Affine3A, Vec3};
+use sim::cloud::ZeroFields;
 use sim::{OrderedCloud, SemanticClass};
 
+use super::buffer::CloudBuffer;
 use super::report::OrderingReport;
 use super::usable::Usable;
 
@@ -268,18 +270,20 @@ pub(crate) fn build_cloud(
     cols: usize,
     planes: usize,
     vehicle_from_sensor: Affine3A,
-    cloud: &mut OrderedCloud,
+    buffer: &mut CloudBuffer,
     report: &mut OrderingReport,
 ) {
-    cloud.reset(rows, cols, planes);
-    for (ring_index, (ring, column)) in
-        cloud.ring.chunks_exact_mut(cols).zip(cloud.column.chunks_exact_mut(cols)).enumerate()
-    {
-        ring.fill((ring_index % rows.max(1)) as u16);
-        for (c, v) in column.iter_mut().enumerate() {
-            *v = c as u32;
-        }
-    }
+    let (cloud, zero) = buffer.parts();
+    cloud.reset_as_grid(rows, cols, planes, *zero);
+    // What this fill leaves at zero: the attributes it lacks, echoes on one plane, and the
+    // instances and normals it never writes.
+    *zero = ZeroFields {
+        time_s: attributes.time_s.is_none(),
+        echo: planes == 1,
+        label: attributes.labels.is_none(),
+        instance: true,
+        normal: true,
+    };
     let plane = rows * cols;
     for (i, &cell) in cell_of_usable.iter().enumerate() {
         report.cell_of_point[usable.point(i)] = Some(cell);
