@@ -1,13 +1,15 @@
 //! The cloud that ordering refills frame after frame ([`CloudBuffer`]): its buffers, and which of
-//! its fields the last fill left at zero, so that the next one does not write them again.
+//! its fields the last fill left at their reset values, so that the next one does not write them
+//! again.
 
 use sim::OrderedCloud;
-use sim::cloud::ZeroFields;
+use sim::cloud::KnownFields;
 
 /// An ordered cloud that [`super::order_cloud_into`] fills frame after frame. It keeps the
-/// buffers (no allocation once they are large enough) and knows which zero fields the last fill
-/// never wrote (a KITTI file has no times, labels, instances or normals), so that the next fill
-/// does not rewrite them ([`OrderedCloud::reset_as_grid`]). The cloud is lent out for reading;
+/// buffers (no allocation once they are large enough) and knows which fields the last fill left
+/// at their reset values (a KITTI file has no times, labels, instances or normals; the ring and
+/// column of every cell are the same for a grid of the same shape), so that the next fill does not
+/// rewrite them ([`OrderedCloud::reset_as_grid`]). The cloud is lent out for reading;
 /// lending it out for writing ([`CloudBuffer::cloud_mut`]) drops that knowledge, so it cannot go
 /// stale.
 ///
@@ -34,8 +36,8 @@ use sim::cloud::ZeroFields;
 #[derive(Clone, Debug, Default)]
 pub struct CloudBuffer {
     cloud: OrderedCloud,
-    /// The zero fields no fill has written since the cloud was last reset in full.
-    zero: ZeroFields,
+    /// The fields that hold their reset values in every cell (what the last fill left alone).
+    known: KnownFields,
 }
 
 impl CloudBuffer {
@@ -47,7 +49,7 @@ impl CloudBuffer {
     /// The cloud for writing (another reader filling the same buffers): the next fill then
     /// resets every field.
     pub fn cloud_mut(&mut self) -> &mut OrderedCloud {
-        self.zero = ZeroFields::default();
+        self.known = KnownFields::default();
         &mut self.cloud
     }
 
@@ -56,9 +58,9 @@ impl CloudBuffer {
         self.cloud
     }
 
-    /// The cloud and what is known of its zero fields, for a fill that keeps the latter true.
-    pub(crate) fn parts(&mut self) -> (&mut OrderedCloud, &mut ZeroFields) {
-        (&mut self.cloud, &mut self.zero)
+    /// The cloud and what is known of its fields, for a fill that keeps the latter true.
+    pub(crate) fn parts(&mut self) -> (&mut OrderedCloud, &mut KnownFields) {
+        (&mut self.cloud, &mut self.known)
     }
 }
 
@@ -90,7 +92,7 @@ mod tests {
 
     /// A frame with times and labels, then one without, a larger grid, and one after the cloud was
     /// written through `cloud_mut`: each refilled cloud equals the cloud ordered afresh, field by
-    /// field, though the second fill skipped the zero fields the first one had not written.
+    /// field, though later fills skipped the fields that the one before had left alone.
     #[test]
     fn a_refilled_cloud_equals_a_fresh_one() {
         let order = |points: &[Vec3], attributes: &PointAttributes<'_>, cols: usize, buffer: &mut CloudBuffer| {
@@ -110,15 +112,21 @@ mod tests {
         let rich = PointAttributes { labels: Some(&labels), time_s: Some(&times), ..PointAttributes::default() };
         order(&half, &rich, 16, &mut buffer);
         assert!(buffer.cloud().ground.iter().filter(|&&g| g).count() == half.len());
-        assert_eq!(buffer.zero, ZeroFields { time_s: false, echo: true, label: false, instance: true, normal: true });
+        assert_eq!(
+            buffer.known,
+            KnownFields { grid: true, time_s: false, echo: true, label: false, instance: true, normal: true }
+        );
         let all = ring_points(1);
         order(&all, &PointAttributes::default(), 16, &mut buffer);
         assert!(buffer.cloud().time_s.iter().all(|&t| t == 0.0) && !buffer.cloud().ground.contains(&true));
-        assert_eq!(buffer.zero, ZeroFields { time_s: true, echo: true, label: true, instance: true, normal: true });
+        assert_eq!(
+            buffer.known,
+            KnownFields { grid: true, time_s: true, echo: true, label: true, instance: true, normal: true }
+        );
         order(&all, &PointAttributes::default(), 32, &mut buffer);
         buffer.cloud_mut().normal[3] = Vec3::Z;
         buffer.cloud_mut().instance[5] = 7;
-        assert_eq!(buffer.zero, ZeroFields::default());
+        assert_eq!(buffer.known, KnownFields::default());
         order(&half, &PointAttributes::default(), 32, &mut buffer);
         assert_eq!((buffer.cloud().normal[3], buffer.cloud().instance[5]), (Vec3::ZERO, 0));
     }

@@ -117,8 +117,8 @@ pub fn order_cloud_into(
             return Err(ClassifyError::Ordering(format!("{name} and points differ in length")));
         }
     }
+    // One entry per point; [`placement::build_cloud`] sets every one of them.
     let mut cell_of_point = std::mem::take(&mut report.cell_of_point);
-    cell_of_point.clear();
     cell_of_point.resize(n, None);
     *report = OrderingReport { cell_of_point, ..OrderingReport::default() };
     let usable = Usable::find(points_in_sensor, report)?;

@@ -8,7 +8,7 @@
 //! from the nearest plane-0 return (`nitsch::echoes_from_plane0`), so no point is left out.
 
 use glam::{Affine3A, Vec3};
-use sim::cloud::ZeroFields;
+use sim::cloud::KnownFields;
 use sim::{OrderedCloud, SemanticClass};
 
 use super::buffer::CloudBuffer;
@@ -273,11 +273,12 @@ pub(crate) fn build_cloud(
     buffer: &mut CloudBuffer,
     report: &mut OrderingReport,
 ) {
-    let (cloud, zero) = buffer.parts();
-    cloud.reset_as_grid(rows, cols, planes, *zero);
-    // What this fill leaves at zero: the attributes it lacks, echoes on one plane, and the
-    // instances and normals it never writes.
-    *zero = ZeroFields {
+    let (cloud, known) = buffer.parts();
+    cloud.reset_as_grid(rows, cols, planes, *known);
+    // What this fill leaves at the reset values: every cell's row and column, the attributes it
+    // lacks, echoes on one plane, and the instances and normals it never writes.
+    *known = KnownFields {
+        grid: true,
         time_s: attributes.time_s.is_none(),
         echo: planes == 1,
         label: attributes.labels.is_none(),
@@ -285,6 +286,11 @@ pub(crate) fn build_cloud(
         normal: true,
     };
     let plane = rows * cols;
+    // Every usable point gets its cell here; the others none (the report's entries are left from
+    // the last frame until now, not cleared first).
+    if usable.indices().is_some() {
+        report.cell_of_point.fill(None);
+    }
     for (i, &cell) in cell_of_usable.iter().enumerate() {
         report.cell_of_point[usable.point(i)] = Some(cell);
     }
