@@ -188,6 +188,27 @@ pub const WRAP_ROWS: usize = 32;
 /// `ceil(rows / WRAP_ROWS)`-th row below it: all rows of a grid that has no more). Returns false
 /// when a column has no return to judge from.
 pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return detect_wrap_avx2(points, rows, cols);
+        }
+    }
+    detect_wrap_body(points, rows, cols)
+}
+
+/// [`detect_wrap_body`] compiled for AVX2 (plain IEEE operations: the same result).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn detect_wrap_avx2(points: &[Vec3], rows: usize, cols: usize) -> bool {
+    detect_wrap_body(points, rows, cols)
+}
+
+/// The body of [`detect_wrap`], inlined into each instruction-set variant.
+#[inline(always)]
+fn detect_wrap_body(points: &[Vec3], rows: usize, cols: usize) -> bool {
     if cols < 3 || rows == 0 || points.len() < rows * cols {
         return false;
     }
