@@ -24,6 +24,7 @@ const EXACT_COLUMNS: f32 = (1u32 << 23) as f32;
 
 /// [`wrap_into`] of every value, in place: one add or subtract (a select that vectorizes) where
 /// every value lies within a turn of `[0, period)`, else [`wrap_into`] itself.
+#[inline(always)]
 fn wrap_all(v: &mut [f32], period: f32) {
     let (lo, hi) = (-period, 2.0 * period);
     let outside = v.iter().fold(0u32, |n, &x| n + u32::from((x < lo) | (x >= hi)));
@@ -36,6 +37,7 @@ fn wrap_all(v: &mut [f32], period: f32) {
 
 /// [`round_fast`] of every value, in place (selects that vectorize); values are column counts,
 /// far inside the `i32` range where this equals `round_fast`.
+#[inline(always)]
 fn round_all(v: &mut [f32]) {
     for x in v {
         let y = *x + 0.5;
@@ -47,6 +49,7 @@ fn round_all(v: &mut [f32]) {
 /// Fractional column steps of the beam azimuths of points with azimuths `az` and horizontal
 /// distances `dist` in row `row` ([`TableRows::column_steps`] of [`TableRows::beam_azimuth`]),
 /// into `steps`.
+#[inline(always)]
 pub(crate) fn column_steps(rows: &TableRows, row: usize, az: &[f32], dist: &[f32], steps: &mut Vec<f32>) {
     let h = rows.horizontal_m[row];
     let (left, step) = (rows.azimuth_left_rad, rows.azimuth_step_rad);
@@ -81,6 +84,43 @@ pub(crate) struct ColumnScratch {
 /// direction) is +1. Returns whether the ring's columns span a full turn, so that two of its
 /// points may share a column.
 pub(crate) fn ring_columns(
+    rows: &TableRows,
+    row: usize,
+    az: &[f32],
+    dist: &[f32],
+    dir: f32,
+    scratch: &mut ColumnScratch,
+    out: &mut [u32],
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return ring_columns_avx2(rows, row, az, dist, dir, scratch, out);
+        }
+    }
+    ring_columns_body(rows, row, az, dist, dir, scratch, out)
+}
+
+/// [`ring_columns_body`] compiled for AVX2 (plain IEEE operations: the same columns).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn ring_columns_avx2(
+    rows: &TableRows,
+    row: usize,
+    az: &[f32],
+    dist: &[f32],
+    dir: f32,
+    scratch: &mut ColumnScratch,
+    out: &mut [u32],
+) -> bool {
+    ring_columns_body(rows, row, az, dist, dir, scratch, out)
+}
+
+/// The body of [`ring_columns`], inlined into each instruction-set variant.
+#[inline(always)]
+fn ring_columns_body(
     rows: &TableRows,
     row: usize,
     az: &[f32],
