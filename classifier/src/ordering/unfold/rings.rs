@@ -29,6 +29,7 @@ fn wrap_pi(a: f32) -> f32 {
 /// The azimuth turned from point to point, summed: `wrap_pi` of every step, added in 8 lanes
 /// (lane `l` takes the steps `l`, `l + 8`, ...) and then lane 0 to 7, a fixed order on every
 /// machine. Only its sign and size are used (the direction of the turn, the number of turns).
+#[inline(always)]
 fn turned(az: &[f32]) -> f32 {
     let mut acc = [0f32; 8];
     let (next, prev) = (&az[1..], &az[..az.len() - 1]);
@@ -54,6 +55,7 @@ fn progress(a: f32, dir: f32, cut: f32) -> f32 {
 
 /// The flags of every point ([`IN_WINDOW`], [`DROP`]): the same comparisons, in the same float
 /// operations, as the rules state them per point.
+#[inline(always)]
 fn flags(az: &[f32], dist: &[f32], dir: f32, params: &UnfoldParams) -> Vec<u8> {
     let n = az.len();
     let (cut, w) = (params.cut_azimuth_rad, params.cut_window_rad);
@@ -119,6 +121,39 @@ fn next_flagged(flags: &[u8], mut j: usize) -> usize {
 /// their nearest beam's origin) into rings; returns the start of each ring, or why the order does
 /// not unfold, with the direction of the turn (+1 counter-clockwise).
 pub(crate) fn ring_starts(
+    az: &[f32],
+    dist: &[f32],
+    fine: &[f32],
+    rows: &TableRows,
+    params: &UnfoldParams,
+) -> Result<(Vec<usize>, f32), String> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return ring_starts_avx2(az, dist, fine, rows, params);
+        }
+    }
+    ring_starts_body(az, dist, fine, rows, params)
+}
+
+/// [`ring_starts_body`] compiled for AVX2 (plain IEEE operations: the same rings).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn ring_starts_avx2(
+    az: &[f32],
+    dist: &[f32],
+    fine: &[f32],
+    rows: &TableRows,
+    params: &UnfoldParams,
+) -> Result<(Vec<usize>, f32), String> {
+    ring_starts_body(az, dist, fine, rows, params)
+}
+
+/// The body of [`ring_starts`], inlined into each instruction-set variant.
+#[inline(always)]
+fn ring_starts_body(
     az: &[f32],
     dist: &[f32],
     fine: &[f32],
