@@ -150,7 +150,7 @@ impl OrderedCloud {
     /// assert_eq!((cloud.rows, cloud.len(), cloud.returns()), (4, 12, 0));
     /// assert!(cloud.time_s.iter().all(|&t| t == 0.0));
     /// assert_eq!((cloud.ring[7], cloud.column[7]), (2, 1));
-    /// // A field marked as zero is trusted, not written.
+    /// // A field marked as known is trusted, not written.
     /// cloud.time_s[4] = 0.2;
     /// cloud.reset_as_grid(4, 3, 1, KnownFields { time_s: true, ..KnownFields::default() });
     /// assert_eq!(cloud.time_s[4], 0.2);
