@@ -193,18 +193,36 @@ pub(super) fn dense_block(
         }
     }
     let mut acc = Acc::default();
-    for (k, &(up, t, back)) in PAIR_TRIANGLE.iter().enumerate() {
-        let chunk = if up { above } else { below };
-        let field = |f: usize| window(chunk, f, back);
-        let (x, y, z) = (field(t * TRI), field(t * TRI + 1), field(t * TRI + 2));
-        let (nl2, inv) = (field(t * TRI + 3), field(t * TRI + 4));
-        let p = (k + 7) % 8;
-        for l in 0..L {
-            let (lk, lp) = (len[k][l], len[p][l]);
-            let tt = lk * lp;
-            let valid = if nl2[l] > 1e-24 * tt * tt { ok[k][l] * ok[p][l] } else { 0.0 };
-            acc.add(l, [x[l], y[l], z[l]], valid * inv[l], valid / (lk + lp).max(f32::MIN_POSITIVE), valid);
-        }
-    }
+    pair::<0>(below, above, &len, &ok, &mut acc);
+    pair::<1>(below, above, &len, &ok, &mut acc);
+    pair::<2>(below, above, &len, &ok, &mut acc);
+    pair::<3>(below, above, &len, &ok, &mut acc);
+    pair::<4>(below, above, &len, &ok, &mut acc);
+    pair::<5>(below, above, &len, &ok, &mut acc);
+    pair::<6>(below, above, &len, &ok, &mut acc);
+    pair::<7>(below, above, &len, &ok, &mut acc);
     acc
+}
+
+/// Pair `K` of [`dense_block`] (a constant, so the triangle's fields are constant offsets).
+#[inline(always)]
+fn pair<const K: usize>(
+    below: &SquareChunk,
+    above: &SquareChunk,
+    len: &[[f32; L]; 8],
+    ok: &[[f32; L]; 8],
+    acc: &mut Acc,
+) {
+    let (up, t, back) = PAIR_TRIANGLE[K];
+    let chunk = if up { above } else { below };
+    let field = |f: usize| window(chunk, f, back);
+    let (x, y, z) = (field(t * TRI), field(t * TRI + 1), field(t * TRI + 2));
+    let (nl2, inv) = (field(t * TRI + 3), field(t * TRI + 4));
+    let p = (K + 7) % 8;
+    for l in 0..L {
+        let (lk, lp) = (len[K][l], len[p][l]);
+        let tt = lk * lp;
+        let valid = if nl2[l] > 1e-24 * tt * tt { ok[K][l] * ok[p][l] } else { 0.0 };
+        acc.add(l, [x[l], y[l], z[l]], valid * inv[l], valid / (lk + lp).max(f32::MIN_POSITIVE), valid);
+    }
 }
