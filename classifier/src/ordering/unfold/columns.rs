@@ -141,38 +141,26 @@ fn ring_columns_body(
             (wrap_once((pair[1] - pair[0]) * col_dir + MAX_BACK_COLUMNS, cols) - MAX_BACK_COLUMNS) * col_dir
         }),
     );
-    let mut u = unwrapped[0];
-    for x in &mut unwrapped[1..] {
-        u += *x;
-        *x = u;
-    }
+    // The running sum, the rounding and the rule `c' = c` unless `(c - last) * col_dir < 1`, then
+    // `last + col_dir`, in one serial pass: on whole numbers the rule is a running maximum (scan
+    // going up the columns) or minimum, a chain of its own beside the sum's (the two overlap).
     // Columns beyond the integers that `f32` holds exactly (NaN included) take the float rule.
-    let exact = unwrapped.iter().fold(true, |ok, &u| ok & (u.abs() < EXACT_COLUMNS));
-    round_all(unwrapped);
-    if !exact {
-        return columns_by_float_rule(unwrapped, rows.cols, col_dir, out);
-    }
-    // The rule `c' = c` unless `(c - last) * col_dir < 1`, then `last + col_dir`, on whole
-    // numbers: a running maximum (scan going up the columns) or minimum.
-    // The running maximum (or minimum) alone is serial; the wrap into `[0, cols)` is a second pass
-    // that vectorizes: a whole number of turns off the first column, then a turn either way at
-    // most (a remainder for the rare ring that strays further).
     let cols_i = rows.cols as i32;
-    let first = unwrapped[0] as i32;
-    let mut last = first - col_dir as i32;
+    let first = round_i32(unwrapped[0]);
     let moved = &mut scratch.moved;
     moved.clear();
-    if col_dir > 0.0 {
-        moved.extend(unwrapped.iter().map(|&c| {
-            last = (c as i32).max(last + 1);
-            last
-        }));
+    let exact = if col_dir > 0.0 {
+        unwrap_and_move::<true>(unwrapped, first - 1, moved)
     } else {
-        moved.extend(unwrapped.iter().map(|&c| {
-            last = (c as i32).min(last - 1);
-            last
-        }));
+        unwrap_and_move::<false>(unwrapped, first + 1, moved)
+    };
+    if !exact {
+        round_all(unwrapped);
+        return columns_by_float_rule(unwrapped, rows.cols, col_dir, out);
     }
+    let last = *moved.last().expect("a ring has points");
+    // The wrap into `[0, cols)` is a second pass that vectorizes: a whole number of turns off the
+    // first column, then a turn either way at most (a remainder for the rare ring that strays further).
     let base = first - first.rem_euclid(cols_i);
     let mut strays = 0u32;
     for (o, &c) in out.iter_mut().zip(moved.iter()) {
@@ -188,6 +176,38 @@ fn ring_columns_body(
         }
     }
     (last - first).abs() >= cols_i
+}
+
+/// [`round_fast`] of `x` as a whole number (`x` well inside the `i32` range; others give some
+/// number, for columns that [`unwrap_and_move`] reports as not exact).
+#[inline(always)]
+fn round_i32(x: f32) -> i32 {
+    let y = x + 0.5;
+    let t = y as i32;
+    if t as f32 > y { t - 1 } else { t }
+}
+
+/// Replaces the increments `unwrapped[1..]` by the running sum from `unwrapped[0]`, and appends to
+/// `moved` each rounded sum moved to at least one column past the last (`UP`) or at most one
+/// column before it, starting from `last`. Returns whether every sum lies within
+/// [`EXACT_COLUMNS`] (else `moved` is meaningless).
+#[inline(always)]
+fn unwrap_and_move<const UP: bool>(unwrapped: &mut [f32], mut last: i32, moved: &mut Vec<i32>) -> bool {
+    let mut u = unwrapped[0];
+    let mut exact = u.abs() < EXACT_COLUMNS;
+    let mut step = |u: f32| {
+        let c = round_i32(u);
+        last = if UP { c.max(last + 1) } else { c.min(last - 1) };
+        last
+    };
+    moved.push(step(u));
+    for x in &mut unwrapped[1..] {
+        u += *x;
+        *x = u;
+        exact &= u.abs() < EXACT_COLUMNS;
+        moved.push(step(u));
+    }
+    exact
 }
 
 /// The moving rule in floats as first written (for unwrapped columns beyond [`EXACT_COLUMNS`]).
