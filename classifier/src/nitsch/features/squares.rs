@@ -193,20 +193,30 @@ pub(super) fn dense_block(
         }
     }
     let mut acc = Acc::default();
-    pair::<0>(below, above, &len, &ok, &mut acc);
-    pair::<1>(below, above, &len, &ok, &mut acc);
-    pair::<2>(below, above, &len, &ok, &mut acc);
-    pair::<3>(below, above, &len, &ok, &mut acc);
-    pair::<4>(below, above, &len, &ok, &mut acc);
-    pair::<5>(below, above, &len, &ok, &mut acc);
-    pair::<6>(below, above, &len, &ok, &mut acc);
-    pair::<7>(below, above, &len, &ok, &mut acc);
+    // Half the lanes at a time: the half's sums stay in registers over the 8 pairs.
+    pair::<0, 0>(below, above, &len, &ok, &mut acc);
+    pair::<1, 0>(below, above, &len, &ok, &mut acc);
+    pair::<2, 0>(below, above, &len, &ok, &mut acc);
+    pair::<3, 0>(below, above, &len, &ok, &mut acc);
+    pair::<4, 0>(below, above, &len, &ok, &mut acc);
+    pair::<5, 0>(below, above, &len, &ok, &mut acc);
+    pair::<6, 0>(below, above, &len, &ok, &mut acc);
+    pair::<7, 0>(below, above, &len, &ok, &mut acc);
+    pair::<0, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<1, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<2, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<3, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<4, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<5, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<6, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<7, { L / 2 }>(below, above, &len, &ok, &mut acc);
     acc
 }
 
-/// Pair `K` of [`dense_block`] (a constant, so the triangle's fields are constant offsets).
+/// Pair `K` of [`dense_block`] for the lanes `H .. H + L / 2` (constants, so the triangle's fields
+/// are constant offsets).
 #[inline(always)]
-fn pair<const K: usize>(
+fn pair<const K: usize, const H: usize>(
     below: &SquareChunk,
     above: &SquareChunk,
     len: &[[f32; L]; 8],
@@ -219,7 +229,7 @@ fn pair<const K: usize>(
     let (x, y, z) = (field(t * TRI), field(t * TRI + 1), field(t * TRI + 2));
     let (nl2, inv) = (field(t * TRI + 3), field(t * TRI + 4));
     let p = (K + 7) % 8;
-    for l in 0..L {
+    for l in H..H + L / 2 {
         let (lk, lp) = (len[K][l], len[p][l]);
         let tt = lk * lp;
         let valid = if nl2[l] > 1e-24 * tt * tt { ok[K][l] * ok[p][l] } else { 0.0 };
