@@ -4,8 +4,8 @@
 //! scan order. A step back of more than [`MAX_BACK_COLUMNS`] (jitter, parallax) is a gap going
 //! forward the long way round.
 //!
-//! The steps, their unwrapping increments and the rounding are vectorized passes; the running sum
-//! and the step that keeps columns moving are serial, the latter on integers (columns are whole
+//! The steps and their unwrapping increments are vectorized passes; the running sum, its rounding
+//! and the step that keeps columns moving are one serial pass, the latter on integers (columns are whole
 //! numbers there, so the float comparisons of the rule are exact integer ones). A ring whose
 //! unwrapped columns could leave the range where that holds (beyond `2^23`: only for absurd input)
 //! takes the float rule instead ([`columns_by_float_rule`]), which gives the same columns wherever
@@ -266,6 +266,33 @@ mod tests {
             assert_eq!(spans, case >= 2, "case {case}");
             assert!(out.iter().all(|&c| (c as usize) < rows.cols));
         }
+    }
+
+    /// The one serial pass: the running sum in place, each sum rounded and moved one column past
+    /// the last at least (or before it, scanning down), and whether every sum is an exact integer
+    /// range (else the caller takes the float rule).
+    #[test]
+    fn unwrap_and_move_sums_rounds_and_moves() {
+        let increments = [10.2f32, 0.4, 0.4, -0.3, 2.0];
+        let mut sums = vec![increments[0]];
+        for x in &increments[1..] {
+            sums.push(sums.last().unwrap() + x);
+        }
+        for (up, start, want) in [(true, 9, [10, 11, 12, 13, 14]), (false, 11, [10, 9, 8, 7, 6])] {
+            let (mut v, mut moved) = (increments.to_vec(), Vec::new());
+            let exact = if up {
+                unwrap_and_move::<true>(&mut v, start, &mut moved)
+            } else {
+                unwrap_and_move::<false>(&mut v, start, &mut moved)
+            };
+            assert!(exact);
+            assert_eq!(v, sums);
+            assert_eq!(moved, want);
+        }
+        // 1e6 + 8e6 columns lie past 2^23: not exact.
+        let (mut v, mut moved) = (vec![1e6f32, 8e6], Vec::new());
+        assert!(!unwrap_and_move::<true>(&mut v, 0, &mut moved));
+        assert_eq!(v, [1e6, 9e6]);
     }
 
     /// The batch steps are bit for bit `column_steps(beam_azimuth(p, row))` per point, with and
