@@ -431,9 +431,10 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
             } else {
                 // A missing neighbour is the cell itself, which never links to itself.
                 for j in search.neighbours_or(view, r, c, i) {
-                    if parent[j] != NONE {
-                        // The unions above may have moved this cell's root.
-                        ri = find(parent, ri);
+                    // `ri` stays this cell's root through the unions (`join` moves it to the
+                    // union's root), so a parent equal to it means the same cluster, as above.
+                    let pj = parent[j];
+                    if pj != NONE && pj != ri {
                         let rj = find(parent, j as u32);
                         join(parent, j, rj, &mut ri);
                     }
