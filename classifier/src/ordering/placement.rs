@@ -147,7 +147,8 @@ pub(crate) fn place_rings(
     report: &mut OrderingReport,
 ) -> (Vec<u32>, usize) {
     let total = column.len();
-    let mut cell_of_point = vec![0u32; total];
+    // Filled ring by ring (not zeroed first: each entry is written before it is read).
+    let mut cell_of_point = Vec::with_capacity(total);
     let mut stacked = Stacked::new(rows * cols);
     // The cells of a spanning ring's row: FREE or the point that holds the cell.
     let mut owner: Vec<u32> = Vec::new();
@@ -155,21 +156,22 @@ pub(crate) fn place_rings(
     let mut lost = 0;
     for ((w, &row), &spans) in bounds.windows(2).zip(row_of_ring).zip(spans_turn) {
         let row0 = row * cols;
-        let (ring, out) = (&column[w[0]..w[1]], &mut cell_of_point[w[0]..w[1]]);
+        let ring = &column[w[0]..w[1]];
+        debug_assert_eq!(cell_of_point.len(), w[0], "rings follow each other");
+        // Every point in its own column's cell: final unless the ring spans a turn and the point
+        // lost the cell to an earlier one (moved or stacked below).
+        cell_of_point.extend(ring.iter().map(|&c| (row0 + c as usize) as u32));
         if !spans {
-            for (o, &c) in out.iter_mut().zip(ring) {
-                *o = (row0 + c as usize) as u32;
-            }
             continue;
         }
+        let out = &mut cell_of_point[w[0]..w[1]];
         owner.clear();
         owner.resize(cols, FREE);
         losers.clear();
-        for (i, (o, &c)) in out.iter_mut().zip(ring).enumerate() {
+        for (i, &c) in ring.iter().enumerate() {
             let c = c as usize;
             if owner[c] == FREE {
                 owner[c] = (w[0] + i) as u32;
-                *o = (row0 + c) as u32;
             } else {
                 losers.push(i);
             }

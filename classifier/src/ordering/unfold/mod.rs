@@ -201,13 +201,16 @@ pub(crate) fn unfold(
         }
         return Ok(Unfolded::Wishes(wishes));
     }
-    let mut column = vec![0u32; usable.len()];
+    // Grown ring by ring, each ring's part zeroed just before it is written (in the level-1
+    // cache), rather than the whole of it zeroed first.
+    let mut column = Vec::with_capacity(usable.len());
     let mut scratch = ColumnScratch::default();
     let spans_turn = bounds
         .windows(2)
         .zip(&row_of_ring)
         .map(|(w, &row)| {
             let (az, dist) = (&az[w[0]..w[1]], &dist[w[0]..w[1]]);
+            column.resize(w[1], 0);
             columns::ring_columns(rows, row, az, dist, dir, &mut scratch, &mut column[w[0]..w[1]])
         })
         .collect();
