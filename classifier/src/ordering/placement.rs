@@ -290,11 +290,19 @@ pub(crate) fn build_cloud(
     let plane = rows * cols;
     // Every usable point gets its cell here; the others none (the report's entries are left from
     // the last frame until now, not cleared first).
-    if usable.indices().is_some() {
-        report.cell_of_point.fill(None);
-    }
-    for (i, &cell) in cell_of_usable.iter().enumerate() {
-        report.cell_of_point[usable.point(i)] = Some(cell);
+    match usable.indices() {
+        // Every point usable: point `i` is usable point `i` (a zip, no index checks).
+        None => {
+            for (o, &cell) in report.cell_of_point.iter_mut().zip(cell_of_usable) {
+                *o = Some(cell);
+            }
+        }
+        Some(idx) => {
+            report.cell_of_point.fill(None);
+            for (&k, &cell) in idx.iter().zip(cell_of_usable) {
+                report.cell_of_point[k as usize] = Some(cell);
+            }
+        }
     }
     // Each field a plain scatter into the cells, in reverse order: where points share a cell, the
     // first one's values are written last and stay (a shared cell keeps its first point).
@@ -321,11 +329,20 @@ fn scatter(
     transform: Option<Affine3A>,
     point: impl Fn(usize) -> usize,
 ) {
+    // The fields cut to the grid's length: a cell checked against it once needs no check per
+    // field.
+    let n = cloud.len();
+    let (points_out, range, sensor) =
+        (&mut cloud.point_in_vehicle[..n], &mut cloud.range_m[..n], &mut cloud.sensor[..n]);
     for (i, &cell) in cells.iter().enumerate().rev() {
         let (p, cell) = (points_in_sensor[point(i)], cell as usize);
-        cloud.point_in_vehicle[cell] = transform.map_or(p, |t| t.transform_point3(p));
-        cloud.range_m[cell] = p.length();
-        cloud.sensor[cell] = 0;
+        if cell >= n {
+            // Never: every cell is one of the grid's.
+            continue;
+        }
+        points_out[cell] = transform.map_or(p, |t| t.transform_point3(p));
+        range[cell] = p.length();
+        sensor[cell] = 0;
     }
     if let Some(v) = attributes.intensity {
         for (i, &cell) in cells.iter().enumerate().rev() {
