@@ -334,19 +334,19 @@ fn scatter(
     let n = cloud.len();
     let (points_out, range, sensor) =
         (&mut cloud.point_in_vehicle[..n], &mut cloud.range_m[..n], &mut cloud.sensor[..n]);
+    let intensity = &mut cloud.intensity[..n];
     for (i, &cell) in cells.iter().enumerate().rev() {
-        let (p, cell) = (points_in_sensor[point(i)], cell as usize);
+        let (k, cell) = (point(i), cell as usize);
         if cell >= n {
             // Never: every cell is one of the grid's.
             continue;
         }
+        let p = points_in_sensor[k];
         points_out[cell] = transform.map_or(p, |t| t.transform_point3(p));
         range[cell] = p.length();
         sensor[cell] = 0;
-    }
-    if let Some(v) = attributes.intensity {
-        for (i, &cell) in cells.iter().enumerate().rev() {
-            cloud.intensity[cell as usize] = v[point(i)];
+        if let Some(v) = attributes.intensity {
+            intensity[cell] = v[k];
         }
     }
     if let Some(t) = attributes.time_s {
