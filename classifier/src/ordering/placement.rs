@@ -304,8 +304,9 @@ pub(crate) fn build_cloud(
             }
         }
     }
-    // Each field a plain scatter into the cells, in reverse order: where points share a cell, the
-    // first one's values are written last and stay (a shared cell keeps its first point).
+    // The fields scattered into the cells (points, ranges and intensities in one loop, times and
+    // labels in their own), in reverse order: where points share a cell, the first one's values
+    // are written last and stay (a shared cell keeps its first point).
     let transform = (vehicle_from_sensor != Affine3A::IDENTITY).then_some(vehicle_from_sensor);
     match usable.indices() {
         None => scatter(cloud, points_in_sensor, attributes, cell_of_usable, transform, |i| i),
