@@ -228,8 +228,9 @@ pub fn linked(pa: Vec3, pb: Vec3, na: Vec3, nb: Vec3, params: &ClusterParams) ->
 ///
 /// Every cluster's root is its smallest cell index (unions keep the smaller root), so the result
 /// does not depend on the order in which links are found. Cells are visited in grid order; a cell
-/// whose 8 direct neighbours all hold returns links to the 4 neighbours already visited (`d4`..`d7`:
-/// down-right, down, down-left, left). The relation is symmetric (see [`GridView::direct_neighbours`]),
+/// whose direct neighbours all hold returns (8 of them; 5 on the first and last rows, which have no
+/// row below or above) links to the neighbours already visited (`d4`..`d7`: down-right, down,
+/// down-left, left; on the first row only left). The relation is symmetric (see [`GridView::direct_neighbours`]),
 /// so together with the other cells, which link to all their neighbours, this finds every link of
 /// the per-cell definition (tested against it).
 pub fn cluster_candidates(
@@ -350,9 +351,11 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
             &ws.search
         }
     };
-    // Only cells with a return can be candidates: the members, each its own root to begin with.
+    // Only cells with a return can be candidates: the members, each its own root to begin with,
+    // in one pass that vectorizes (no fill followed by a write per member).
     ws.parent.clear();
-    ws.parent.resize(n, NONE);
+    ws.parent
+        .extend(candidate[..n].iter().zip(valid).enumerate().map(|(i, (&c, &v))| if c & v { i as u32 } else { NONE }));
     // The member list (in increasing order): the passes below visit only the members. Per 64
     // cells a bit mask (8 cells per multiplication, [`pack8`]), whose set bits are then listed:
     // a step per member, none per cell.
@@ -371,7 +374,6 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
         while mask != 0 {
             let i = (k * 64) as u32 + mask.trailing_zeros();
             ws.members.push(i);
-            ws.parent[i as usize] = i;
             mask &= mask - 1;
         }
     }
@@ -386,12 +388,13 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
     let mut next = 0;
     for r in 0..rows {
         let row = r * cols..(r + 1) * cols;
-        let interior_row = r > 0 && r + 1 < rows;
-        if interior_row {
-            let (below, at, above) = (&valid[row.start - cols..], &valid[row.clone()], &valid[row.end..]);
-            for (c, v) in column_valid.iter_mut().enumerate() {
-                *v = below[c] & at[c] & above[c];
-            }
+        // The first and last rows have no row below or above: their direct neighbours are those
+        // of the rows the grid has (the search finds nothing beyond them either).
+        let at = &valid[row.clone()];
+        let below = if r > 0 { &valid[row.start - cols..row.start] } else { at };
+        let above = if r + 1 < rows { &valid[row.end..row.end + cols] } else { at };
+        for (((v, &b), &a), &u) in column_valid.iter_mut().zip(below).zip(at).zip(above) {
+            *v = b & a & u;
         }
         // The previous member and its cluster's root.
         let (mut prev, mut prev_root) = (usize::MAX, NONE);
@@ -406,8 +409,7 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
             // The left neighbour's root when it is a member (NONE otherwise).
             let left_root = if prev.wrapping_add(1) == i { prev_root } else { NONE };
             let (p, np) = (points[i], normal[i]);
-            let dense =
-                interior_row && c > 0 && c + 1 < cols && column_valid[c - 1] & column_valid[c] & column_valid[c + 1];
+            let dense = c > 0 && c + 1 < cols && column_valid[c - 1] & column_valid[c] & column_valid[c + 1];
             // Root of this cell's cluster, kept up to date through the unions below.
             let mut ri = if parent[i] == i as u32 { i as u32 } else { find(parent, i as u32) };
             // A link only matters between different clusters, so the roots are compared before
@@ -424,13 +426,16 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
                 if left_root != NONE {
                     join(parent, i - 1, left_root, &mut ri);
                 }
-                for j in [i - cols - 1, i - cols, i - cols + 1] {
-                    // A parent equal to this cell's root (a root) means the same cluster already:
-                    // no search (the common case inside a surface).
-                    let pj = parent[j];
-                    if pj != NONE && pj != ri {
-                        let rj = find(parent, j as u32);
-                        join(parent, j, rj, &mut ri);
+                // The row below (the first row has none).
+                if r > 0 {
+                    for j in [i - cols - 1, i - cols, i - cols + 1] {
+                        // A parent equal to this cell's root (a root) means the same cluster
+                        // already: no search (the common case inside a surface).
+                        let pj = parent[j];
+                        if pj != NONE && pj != ri {
+                            let rj = find(parent, j as u32);
+                            join(parent, j, rj, &mut ri);
+                        }
                     }
                 }
             } else {
