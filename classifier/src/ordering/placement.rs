@@ -333,22 +333,19 @@ fn scatter(
     // The fields cut to the grid's length: a cell checked against it once needs no check per
     // field.
     let n = cloud.len();
-    let (points_out, range, sensor) =
-        (&mut cloud.point_in_vehicle[..n], &mut cloud.range_m[..n], &mut cloud.sensor[..n]);
-    let intensity = &mut cloud.intensity[..n];
-    for (i, &cell) in cells.iter().enumerate().rev() {
-        let (k, cell) = (point(i), cell as usize);
-        if cell >= n {
-            // Never: every cell is one of the grid's.
-            continue;
-        }
-        let p = points_in_sensor[k];
-        points_out[cell] = transform.map_or(p, |t| t.transform_point3(p));
-        range[cell] = p.length();
-        sensor[cell] = 0;
-        if let Some(v) = attributes.intensity {
-            intensity[cell] = v[k];
-        }
+    let fields = Fields {
+        points: &mut cloud.point_in_vehicle[..n],
+        range: &mut cloud.range_m[..n],
+        sensor: &mut cloud.sensor[..n],
+        intensity: &mut cloud.intensity[..n],
+    };
+    // One loop per case, so that no case is tested per point.
+    let t = transform.unwrap_or(Affine3A::IDENTITY);
+    match (transform.is_some(), attributes.intensity) {
+        (false, None) => scatter_points::<false, false>(fields, points_in_sensor, &[], cells, t, &point),
+        (false, Some(v)) => scatter_points::<false, true>(fields, points_in_sensor, v, cells, t, &point),
+        (true, None) => scatter_points::<true, false>(fields, points_in_sensor, &[], cells, t, &point),
+        (true, Some(v)) => scatter_points::<true, true>(fields, points_in_sensor, v, cells, t, &point),
     }
     if let Some(t) = attributes.time_s {
         for (i, &cell) in cells.iter().enumerate().rev() {
@@ -359,6 +356,45 @@ fn scatter(
         for (i, &cell) in cells.iter().enumerate().rev() {
             let l = l[point(i)];
             (cloud.label[cell as usize], cloud.ground[cell as usize]) = (l, l.is_ground());
+        }
+    }
+}
+
+/// The cloud's fields that [`scatter_points`] writes, cut to the grid's length.
+struct Fields<'a> {
+    points: &'a mut [Vec3],
+    range: &'a mut [f32],
+    sensor: &'a mut [u8],
+    intensity: &'a mut [f32],
+}
+
+/// [`scatter`]'s points, ranges, sensors and (where `INTENSITY`) intensities, transformed by `t`
+/// where `TRANSFORM`.
+#[inline(always)]
+fn scatter_points<const TRANSFORM: bool, const INTENSITY: bool>(
+    fields: Fields<'_>,
+    points_in_sensor: &[Vec3],
+    intensity_in: &[f32],
+    cells: &[u32],
+    t: Affine3A,
+    point: &impl Fn(usize) -> usize,
+) {
+    let n = fields.points.len();
+    // The inputs cut to one length: a point index checked against it once needs no check per field.
+    let m = if INTENSITY { points_in_sensor.len().min(intensity_in.len()) } else { points_in_sensor.len() };
+    let (points_in, intensity_in) = (&points_in_sensor[..m], &intensity_in[..if INTENSITY { m } else { 0 }]);
+    for (i, &cell) in cells.iter().enumerate().rev() {
+        let (k, cell) = (point(i), cell as usize);
+        if cell >= n || k >= m {
+            // Never: every cell is one of the grid's, every index one of the points'.
+            continue;
+        }
+        let p = points_in[k];
+        fields.points[cell] = if TRANSFORM { t.transform_point3(p) } else { p };
+        fields.range[cell] = p.length();
+        fields.sensor[cell] = 0;
+        if INTENSITY {
+            fields.intensity[cell] = intensity_in[k];
         }
     }
 }

@@ -26,12 +26,7 @@ impl Usable {
             return Err(ClassifyError::Ordering(format!("{} points are too many", points.len())));
         }
         // A counting pass without branches (it vectorizes); the index list only where needed.
-        let (mut bad, mut zero) = (0usize, 0usize);
-        for p in points {
-            let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
-            bad += usize::from(!finite);
-            zero += usize::from((p.x == 0.0) & (p.y == 0.0) & (p.z == 0.0));
-        }
+        let (bad, zero) = count_bad_and_zero(points);
         report.skipped += bad;
         report.no_returns += zero;
         if report.skipped as f64 > MAX_BAD_FRACTION * points.len() as f64 {
@@ -74,6 +69,39 @@ impl Usable {
     pub(crate) fn iter(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.len).map(|i| self.point(i) as u32)
     }
+}
+
+/// Points with a non-finite coordinate and points at (0, 0, 0), counted (compiled for AVX2
+/// where the CPU has it: the same counts, about half the instructions of the baseline build).
+fn count_bad_and_zero(points: &[Vec3]) -> (usize, usize) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return count_avx2(points);
+        }
+    }
+    count_body(points)
+}
+
+/// [`count_body`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn count_avx2(points: &[Vec3]) -> (usize, usize) {
+    count_body(points)
+}
+
+/// The body of [`count_bad_and_zero`], inlined into each instruction-set variant.
+#[inline(always)]
+fn count_body(points: &[Vec3]) -> (usize, usize) {
+    let (mut bad, mut zero) = (0usize, 0usize);
+    for p in points {
+        let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+        bad += usize::from(!finite);
+        zero += usize::from((p.x == 0.0) & (p.y == 0.0) & (p.z == 0.0));
+    }
+    (bad, zero)
 }
 
 #[cfg(test)]
