@@ -175,6 +175,9 @@ pub struct ClusterWorkspace {
     valid: Vec<bool>,
     /// Per column of the row being clustered: returns in the rows below, at and above.
     column_valid: Vec<bool>,
+    /// Per column of the row being clustered: all direct neighbours hold returns (the columns
+    /// either side of a `column_valid` one are `column_valid` too).
+    dense: Vec<bool>,
     /// The tables of the neighbour search of cells that lack a direct neighbour.
     search: RowReturns,
     /// Cluster roots in increasing order (the per-root arrays are only read and reset there).
@@ -380,10 +383,13 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
     // Per column of the current row: returns in the rows below, at and above.
     ws.column_valid.clear();
     ws.column_valid.resize(cols, false);
+    ws.dense.clear();
+    ws.dense.resize(cols, false);
     // Slices of the grid's length, so that an index checked against `n` once needs no further
     // bounds checks (the loop below runs about 100 instructions per candidate).
     let parent = &mut ws.parent[..n];
     let column_valid = &mut ws.column_valid[..cols];
+    let dense_column = &mut ws.dense[..cols];
     // Index of the next member to visit.
     let mut next = 0;
     for r in 0..rows {
@@ -396,8 +402,15 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
         for (((v, &b), &a), &u) in column_valid.iter_mut().zip(below).zip(at).zip(above) {
             *v = b & a & u;
         }
-        // The previous member and its cluster's root.
-        let (mut prev, mut prev_root) = (usize::MAX, NONE);
+        // Columns 0 and `cols - 1` stay false (their neighbours across the edge are not direct).
+        if cols >= 3 {
+            let (left, centre, right) = (&column_valid[..cols - 2], &column_valid[1..cols - 1], &column_valid[2..]);
+            for (((d, &l), &m), &r) in dense_column[1..cols - 1].iter_mut().zip(left).zip(centre).zip(right) {
+                *d = l & m & r;
+            }
+        }
+        // The previous member, its cluster's root, point and normal.
+        let (mut prev, mut prev_root, mut prev_p, mut prev_np) = (usize::MAX, NONE, Vec3::ZERO, Vec3::ZERO);
         while next < ws.members.len() && (ws.members[next] as usize) < row.end {
             let i = ws.members[next] as usize;
             if i >= n {
@@ -409,13 +422,14 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
             // The left neighbour's root when it is a member (NONE otherwise).
             let left_root = if prev.wrapping_add(1) == i { prev_root } else { NONE };
             let (p, np) = (points[i], normal[i]);
-            let dense = c > 0 && c + 1 < cols && column_valid[c - 1] & column_valid[c] & column_valid[c + 1];
+            let dense = dense_column[c];
             // Root of this cell's cluster, kept up to date through the unions below.
             let mut ri = if parent[i] == i as u32 { i as u32 } else { find(parent, i as u32) };
             // A link only matters between different clusters, so the roots are compared before
-            // the (pure) link test: the partition is the same, with far fewer tests.
-            let join = |parent: &mut [u32], j: usize, rj: u32, ri: &mut u32| {
-                if rj != *ri && j != i && linked(p, points[j], np, normal[j], params) {
+            // the (pure) link test: the partition is the same, with far fewer tests. (The cell
+            // itself, a missing neighbour of the search, has this cell's root: never linked.)
+            let join = |parent: &mut [u32], q: Vec3, nq: Vec3, rj: u32, ri: &mut u32| {
+                if rj != *ri && linked(p, q, np, nq, params) {
                     // Union by index: every root is its cluster's smallest cell.
                     let (lo, hi) = if *ri < rj { (*ri, rj) } else { (rj, *ri) };
                     parent[hi as usize] = lo;
@@ -424,7 +438,8 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
             };
             if dense {
                 if left_root != NONE {
-                    join(parent, i - 1, left_root, &mut ri);
+                    // The left neighbour is the previous member: its point and normal are at hand.
+                    join(parent, prev_p, prev_np, left_root, &mut ri);
                 }
                 // The row below (the first row has none).
                 if r > 0 {
@@ -434,7 +449,7 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
                         let pj = parent[j];
                         if pj != NONE && pj != ri {
                             let rj = find(parent, j as u32);
-                            join(parent, j, rj, &mut ri);
+                            join(parent, points[j], normal[j], rj, &mut ri);
                         }
                     }
                 }
@@ -446,11 +461,11 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
                     let pj = parent[j];
                     if pj != NONE && pj != ri {
                         let rj = find(parent, j as u32);
-                        join(parent, j, rj, &mut ri);
+                        join(parent, points[j], normal[j], rj, &mut ri);
                     }
                 }
             }
-            (prev, prev_root) = (i, ri);
+            (prev, prev_root, prev_p, prev_np) = (i, ri, p, np);
         }
     }
     // Path compression, cluster sizes, the member list and each cluster's x-y bounding box in one
