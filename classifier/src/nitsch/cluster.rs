@@ -175,8 +175,9 @@ pub struct ClusterWorkspace {
     valid: Vec<bool>,
     /// Per column of the row being clustered: returns in the rows below, at and above.
     column_valid: Vec<bool>,
-    /// Per column of the row being clustered: all direct neighbours hold returns (the columns
-    /// either side of a `column_valid` one are `column_valid` too).
+    /// Per column of the row being clustered: the column and the columns either side of it are
+    /// `column_valid`, so a cell there has all its direct neighbours (false in the first and last
+    /// columns).
     dense: Vec<bool>,
     /// The tables of the neighbour search of cells that lack a direct neighbour.
     search: RowReturns,
