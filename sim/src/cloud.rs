@@ -72,6 +72,17 @@ fn filled<T: Clone + Send + Sync>(value: T, n: usize) -> Vec<T> {
     v
 }
 
+/// `Vec3::NAN` in every entry of `points`, four entries per 48-byte copy: the compiler writes
+/// those as whole vector stores, where a fill writes each 12-byte entry as two stores (the fill
+/// of a KITTI frame's grid took about 0.08 ms of its ordering).
+fn fill_nan(points: &mut [Vec3]) {
+    let mut quads = points.chunks_exact_mut(4);
+    for q in &mut quads {
+        q.copy_from_slice(&[Vec3::NAN; 4]);
+    }
+    quads.into_remainder().fill(Vec3::NAN);
+}
+
 impl OrderedCloud {
     /// A grid of `planes * rows * cols` no-return cells (sensor `u8::MAX`, time 0). The fields are
     /// filled in parallel (a 128 x 2048 grid is 14 MB).
@@ -159,7 +170,7 @@ impl OrderedCloud {
         let n = rows * cols * planes;
         let same_grid = known.grid && (self.rows, self.cols, self.planes, self.len()) == (rows, cols, planes, n);
         self.reshape(rows, cols, planes);
-        self.point_in_vehicle[..n].fill(Vec3::NAN);
+        fill_nan(&mut self.point_in_vehicle[..n]);
         self.range_m[..n].fill(f32::NAN);
         self.intensity[..n].fill(0.0);
         self.sensor[..n].fill(u8::MAX);
@@ -193,7 +204,7 @@ impl OrderedCloud {
 
     /// Sets cells `range` back to no-return cells (as [`OrderedCloud::empty`] makes them).
     pub fn reset_cells(&mut self, range: std::ops::Range<usize>) {
-        self.point_in_vehicle[range.clone()].fill(Vec3::NAN);
+        fill_nan(&mut self.point_in_vehicle[range.clone()]);
         self.range_m[range.clone()].fill(f32::NAN);
         self.intensity[range.clone()].fill(0.0);
         self.ring[range.clone()].fill(0);

@@ -32,6 +32,7 @@
 use glam::Vec3;
 
 use crate::error::is_valid;
+use crate::ordering::polar::atan2_lane;
 
 /// How many rows up or down [`GridView::neighbours`] looks for a row with a return near the
 /// column (module docs): 3 skips the two empty rows at the edges of the merged `lux-roof-4` grid.
@@ -215,22 +216,27 @@ fn detect_wrap_body(points: &[Vec3], rows: usize, cols: usize) -> bool {
     // The farthest return of every column (the first of equals, going up the rows), found in one
     // branch-free pass in memory order: squared distances are >= 0, so -inf means none yet.
     let mut far_d2 = vec![f32::NEG_INFINITY; cols];
-    let mut far_row = vec![0u32; cols];
+    let (mut far_x, mut far_y) = (vec![0f32; cols], vec![0f32; cols]);
     // Counted from the top row, where far returns are: the sample always includes it.
     let step = rows.div_ceil(WRAP_ROWS);
     let sampled = (0..rows).filter(|r| (rows - 1 - r).is_multiple_of(step));
-    for (r, row) in sampled.map(|r| (r, &points[r * cols..(r + 1) * cols])) {
-        for ((bd, br), p) in far_d2.iter_mut().zip(far_row.iter_mut()).zip(row) {
+    for row in sampled.map(|r| &points[r * cols..(r + 1) * cols]) {
+        for (((bd, bx), by), p) in far_d2.iter_mut().zip(far_x.iter_mut()).zip(far_y.iter_mut()).zip(row) {
             let d2 = p.x * p.x + p.y * p.y;
             let better = (p.x.is_finite() & p.y.is_finite() & p.z.is_finite()) & (d2 > *bd);
             *bd = if better { d2 } else { *bd };
-            *br = if better { r as u32 } else { *br };
+            (*bx, *by) = if better { (p.x, p.y) } else { (*bx, *by) };
         }
     }
-    let col_azimuth = |c: usize| -> Option<f32> {
-        let p = points[far_row[c] as usize * cols + c];
-        (far_d2[c] > f32::NEG_INFINITY).then(|| p.y.atan2(p.x))
-    };
+    // The columns' azimuths in one pass that vectorizes (a polynomial within 1e-6 rad of libm's
+    // `atan2`, which as a call per column took 0.04 ms of a KITTI frame); NaN where none.
+    let azimuth: Vec<f32> = far_x
+        .iter()
+        .zip(&far_y)
+        .zip(&far_d2)
+        .map(|((&x, &y), &d2)| if d2 > f32::NEG_INFINITY { atan2_lane(y, x) } else { f32::NAN })
+        .collect();
+    let col_azimuth = |c: usize| -> Option<f32> { (far_d2[c] > f32::NEG_INFINITY).then_some(azimuth[c]) };
     let wrap_diff = |a: f32, b: f32| {
         let mut d = a - b;
         while d > std::f32::consts::PI {

@@ -28,7 +28,7 @@ mod buffer;
 pub mod calibration;
 pub mod organized;
 pub mod placement;
-mod polar;
+pub(crate) mod polar;
 pub mod report;
 pub mod table;
 pub mod unfold;

@@ -60,16 +60,24 @@ fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Ve
             od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
             of[l] = z[l] / od[l].max(1e-6);
         }
-        az.extend_from_slice(&oa[..n]);
-        dist.extend_from_slice(&od[..n]);
-        fine.extend_from_slice(&of[..n]);
+        // Whole blocks as copies of constant length (inlined as vector moves: a copy of `n`
+        // floats was a `memcpy` call per block and output).
+        if n == LANES {
+            az.extend_from_slice(&oa);
+            dist.extend_from_slice(&od);
+            fine.extend_from_slice(&of);
+        } else {
+            az.extend_from_slice(&oa[..n]);
+            dist.extend_from_slice(&od[..n]);
+            fine.extend_from_slice(&of[..n]);
+        }
     }
     (az, dist, fine)
 }
 
 /// [`fast_atan2`] with its branches as selects (it vectorizes); the same bits for every input.
 #[inline(always)]
-fn atan2_lane(y: f32, x: f32) -> f32 {
+pub(crate) fn atan2_lane(y: f32, x: f32) -> f32 {
     use std::f32::consts::{FRAC_PI_2, PI};
     let (ax, ay) = (x.abs(), y.abs());
     let swap = ay > ax;
