@@ -73,8 +73,9 @@ fn filled<T: Clone + Send + Sync>(value: T, n: usize) -> Vec<T> {
 }
 
 /// `Vec3::NAN` in every entry of `points`, four entries per 48-byte copy: the compiler writes
-/// those as whole vector stores, where a fill writes each 12-byte entry as two stores (the fill
-/// of a KITTI frame's grid took about 0.08 ms of its ordering).
+/// those as whole vector stores, where a fill writes each 12-byte entry as two stores (sampled
+/// on KITTI frames: the grid's reset went from 1.6 to 1.2 % of the time of read, order and
+/// classify).
 fn fill_nan(points: &mut [Vec3]) {
     let mut quads = points.chunks_exact_mut(4);
     for q in &mut quads {

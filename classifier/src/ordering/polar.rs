@@ -60,17 +60,9 @@ fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Ve
             od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
             of[l] = z[l] / od[l].max(1e-6);
         }
-        // Whole blocks as copies of constant length (inlined as vector moves: a copy of `n`
-        // floats was a `memcpy` call per block and output).
-        if n == LANES {
-            az.extend_from_slice(&oa);
-            dist.extend_from_slice(&od);
-            fine.extend_from_slice(&of);
-        } else {
-            az.extend_from_slice(&oa[..n]);
-            dist.extend_from_slice(&od[..n]);
-            fine.extend_from_slice(&of[..n]);
-        }
+        az.extend_from_slice(&oa[..n]);
+        dist.extend_from_slice(&od[..n]);
+        fine.extend_from_slice(&of[..n]);
     }
     (az, dist, fine)
 }
