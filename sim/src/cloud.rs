@@ -317,4 +317,22 @@ mod tests {
             assert_eq!(bits(q), bits(&want), "point {k}");
         }
     }
+
+    /// Grids of every length modulo 4 (the fill's whole quads and its remainder), reset after a
+    /// frame of returns, hold no return in any cell; a reset of a range leaves the cells outside it.
+    #[test]
+    fn resets_clear_every_point_whole_quads_and_remainder() {
+        for (rows, cols) in [(1, 1), (2, 3), (3, 3), (5, 7), (4, 4)] {
+            let mut cloud = super::OrderedCloud::empty(rows, cols, 1);
+            cloud.point_in_vehicle.iter_mut().enumerate().for_each(|(i, p)| *p = Vec3::splat(i as f32 + 1.0));
+            cloud.reset_as_grid(rows, cols, 1, super::KnownFields::default());
+            assert_eq!(cloud.point_in_vehicle.len(), rows * cols);
+            assert!(cloud.point_in_vehicle.iter().all(|p| p.is_nan()), "{rows} x {cols}");
+            cloud.point_in_vehicle.iter_mut().for_each(|p| *p = Vec3::ONE);
+            cloud.reset_cells(1..rows * cols);
+            assert_eq!(cloud.point_in_vehicle[0], Vec3::ONE);
+            let nan = cloud.point_in_vehicle[1..].iter().filter(|p| p.x.is_nan() && p.y.is_nan() && p.z.is_nan());
+            assert_eq!(nan.count(), rows * cols - 1, "{rows} x {cols}");
+        }
+    }
 }
