@@ -40,7 +40,8 @@ pub struct OrderingReport {
     /// Cell index (over all planes) of each input point; `None` only for skipped bad points.
     #[serde(skip)]
     pub cell_of_point: Vec<Option<u32>>,
-    /// Rings found by unfolding (0 on the other paths).
+    /// Rings found: unfolded from the scan order, or the rings that hold points of an organized
+    /// cloud or of a cloud with a `ring` field (0 on the beam-table path).
     pub rings_found: usize,
     /// Points placed in the cell their row and azimuth name.
     pub placed: usize,
@@ -81,7 +82,8 @@ impl OrderingReport {
             self.no_returns
         );
         if self.rings_found > 0 {
-            s.push_str(&format!(", {} rings unfolded", self.rings_found));
+            let what = if self.path == OrderingPath::Unfolded { "rings unfolded" } else { "rings with points" };
+            s.push_str(&format!(", {} {what}", self.rings_found));
         }
         if self.outside > 0 {
             s.push_str(&format!(", {} beyond the beam table (kept in the edge row)", self.outside));
@@ -90,5 +92,22 @@ impl OrderingReport {
             s.push_str(&format!(" (not unfolded: {f})"));
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The summary says how the rings were found: unfolded from the scan order, or read.
+    #[test]
+    fn summary_names_how_rings_were_found() {
+        let mut report =
+            OrderingReport { path: OrderingPath::Unfolded, rings_found: 64, placed: 10, ..Default::default() };
+        assert!(report.summary().ends_with(", 64 rings unfolded"), "{}", report.summary());
+        (report.path, report.rings_found) = (OrderingPath::Organized, 128);
+        assert!(report.summary().ends_with(", 128 rings with points"), "{}", report.summary());
+        (report.path, report.rings_found) = (OrderingPath::BeamTable, 0);
+        assert!(!report.summary().contains("rings"), "{}", report.summary());
     }
 }
