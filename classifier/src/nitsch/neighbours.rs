@@ -230,13 +230,8 @@ fn detect_wrap_body(points: &[Vec3], rows: usize, cols: usize) -> bool {
     }
     // The columns' azimuths in one pass that vectorizes (a polynomial within 1e-6 rad of libm's
     // `atan2`; sampled on KITTI frames, the test went from 1.5 to 1.05 % of the time of read,
-    // order and classify); NaN where none.
-    let azimuth: Vec<f32> = far_x
-        .iter()
-        .zip(&far_y)
-        .zip(&far_d2)
-        .map(|((&x, &y), &d2)| if d2 > f32::NEG_INFINITY { atan2_lane(y, x) } else { f32::NAN })
-        .collect();
+    // order and classify); read only for columns with a return.
+    let azimuth: Vec<f32> = far_x.iter().zip(&far_y).map(|(&x, &y)| atan2_lane(y, x)).collect();
     let col_azimuth = |c: usize| -> Option<f32> { (far_d2[c] > f32::NEG_INFINITY).then_some(azimuth[c]) };
     let wrap_diff = |a: f32, b: f32| {
         let mut d = a - b;
