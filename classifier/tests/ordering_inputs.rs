@@ -255,3 +255,35 @@ fn rows_under_a_ceiling_are_put_in_elevation_order() {
         assert_eq!(ordered.point_in_vehicle, bottom.point_in_vehicle, "stored top-first: {top_first}");
     }
 }
+
+/// KITTI records (`x y z intensity`) ordered where they lie give the cloud and the report of the
+/// same points with their intensities given apart: scan order (unfolded), shuffled with bad
+/// points (the beam table), with a transform, and with labels.
+#[test]
+fn records_order_as_points_with_intensities() {
+    let (table, pts, _) = kitti_like(360);
+    let n = pts.len();
+    let mut shuffled: Vec<Vec3> = (0..n).map(|k| pts[(k * 7919 + 13) % n]).collect();
+    shuffled[5] = Vec3::new(f32::NAN, 0.0, 0.0);
+    shuffled[99] = Vec3::ZERO;
+    let labels: Vec<_> = (0..n).map(|k| sim::SemanticClass(if k % 3 == 0 { 40 } else { 50 })).collect();
+    let vehicle_from_sensor = Affine3A::from_translation(Vec3::new(0.5, 0.0, 1.9));
+    for (points, transform, with_labels) in
+        [(&pts, Affine3A::IDENTITY, false), (&shuffled, vehicle_from_sensor, true), (&pts, vehicle_from_sensor, true)]
+    {
+        let intensity: Vec<f32> = (0..n).map(|k| (k % 251) as f32 / 250.0).collect();
+        let records: Vec<[f32; 4]> = points.iter().zip(&intensity).map(|(p, &i)| [p.x, p.y, p.z, i]).collect();
+        let labels = with_labels.then_some(labels.as_slice());
+        let apart = PointAttributes { intensity: Some(&intensity), labels, ..PointAttributes::default() };
+        let (choice, params) = (PathChoice::Auto, UnfoldParams::default());
+        let (want, want_report) = order_cloud(points, &apart, &table, transform, choice, &params).unwrap();
+        let own = PointAttributes { labels, ..PointAttributes::default() };
+        let (got, got_report) = order_cloud(&records, &own, &table, transform, choice, &params).unwrap();
+        assert_eq!(got_report, want_report);
+        assert_eq!(got.intensity, want.intensity);
+        assert_eq!(got.label, want.label);
+        let bits = |c: &sim::OrderedCloud| c.point_in_vehicle.iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&want));
+        assert!(got.intensity.iter().filter(|&&i| i > 0.0).count() > n / 2);
+    }
+}

@@ -288,6 +288,41 @@ fn kitti_label_length_must_match_bin() {
     assert!(m.contains("not a multiple of 16"), "{m}");
 }
 
+/// The records read in place where the bytes are aligned, decoded where they are not: the same
+/// points, intensities and labels either way, and the same refusals.
+#[test]
+fn kitti_records_in_place_or_decoded_agree() {
+    let cloud = synthetic(4, 10, 1);
+    let (bin, label, n) = kitti::encode(&cloud, None).unwrap();
+    let (bp, lp) = (Path::new("x.bin"), Path::new("x.label"));
+    let want = kitti::points_from_bytes(bp, &bin, Some((lp, &label))).unwrap();
+    // Aligned (a `Vec<u32>`'s bytes) and one byte off.
+    let words: Vec<u32> = bin.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+    let aligned: &[u8] = bytemuck::cast_slice(&words);
+    let mut shifted = vec![0u8];
+    shifted.extend_from_slice(&bin);
+    let mut out = kitti::KittiPoints::default();
+    let records = kitti::records_or_points_into(bp, aligned, Some((lp, &label)), &mut out).unwrap().expect("in place");
+    assert_eq!(records.len(), n);
+    for (k, r) in records.iter().enumerate() {
+        assert_eq!((Vec3::new(r[0], r[1], r[2]), r[3]), (want.points[k], want.intensity[k]), "record {k}");
+    }
+    assert!(out.points.is_empty() && out.labels == want.labels);
+    let misaligned = &shifted[1..];
+    if misaligned.as_ptr() as usize % 4 != 0 {
+        let got = kitti::records_or_points_into(bp, misaligned, Some((lp, &label)), &mut out).unwrap();
+        assert!(got.is_none());
+        assert_eq!(out, want);
+    }
+    let m = bad_file_message(kitti::records_or_points_into(bp, &aligned[..70], None, &mut out).unwrap_err(), bp);
+    assert!(m.contains("not a multiple of 16"), "{m}");
+    let m = bad_file_message(
+        kitti::records_or_points_into(bp, aligned, Some((lp, &label[4..])), &mut out).unwrap_err(),
+        lp,
+    );
+    assert!(m.contains("labels"), "{m}");
+}
+
 #[test]
 fn ply_truncated_is_refused() {
     let cloud = synthetic(4, 10, 1);

@@ -52,7 +52,12 @@ fn read_any(kind: &str, bytes: &[u8]) -> bool {
         _ => {
             // Split the bytes into a .bin part (multiple of 16 when possible) and a .label part.
             let split = bytes.len() * 4 / 5 / 16 * 16;
-            kitti::read_bytes(p, &bytes[..split], Some((Path::new("fuzz.label"), &bytes[split..]))).is_ok()
+            let (bin, label) = (&bytes[..split], Some((Path::new("fuzz.label"), &bytes[split..])));
+            let mut out = kitti::KittiPoints::default();
+            let in_place = kitti::records_or_points_into(p, bin, label, &mut out).is_ok();
+            let read = kitti::read_bytes(p, bin, label).is_ok();
+            assert_eq!(in_place, read, "the two readers refuse the same files");
+            read
         }
     }
 }

@@ -164,10 +164,10 @@ impl SensorSetup {
     }
 
     /// Orders a flat cloud (KITTI `.bin`, unorganized PCD, PLY) into `cloud` and `report`.
-    fn order_flat(
+    fn order_flat<P: classifier::ordering::InputPoint>(
         &self,
         path: &Path,
-        points: &[glam::Vec3],
+        points: &[P],
         attributes: &PointAttributes<'_>,
         cloud: &mut CloudBuffer,
         report: &mut OrderingReport,
@@ -267,16 +267,23 @@ impl FrameReader {
                     true => Some((label.as_path(), self.label_bytes.load(&label)?)),
                     false => None,
                 };
-                sim::io::kitti::points_from_bytes_into(path, bytes, label_bytes, &mut self.flat)?;
+                // The records are ordered where the file's bytes lie (no decoding copy) where
+                // they can be; the points are decoded otherwise.
+                let records = sim::io::kitti::records_or_points_into(path, bytes, label_bytes, &mut self.flat)?;
                 let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                 let flat = &self.flat;
-                let attributes = PointAttributes {
-                    intensity: Some(&flat.intensity),
-                    labels: flat.labels.as_deref(),
-                    time_s: None,
-                    rings: None,
-                };
-                setup.order_flat(path, &flat.points, &attributes, &mut self.cloud, &mut self.report)?;
+                let labels = flat.labels.as_deref();
+                match records {
+                    Some(records) => {
+                        // Intensities from the records themselves.
+                        let attributes = PointAttributes { labels, ..PointAttributes::default() };
+                        setup.order_flat(path, records, &attributes, &mut self.cloud, &mut self.report)?;
+                    }
+                    None => {
+                        let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, ..PointAttributes::default() };
+                        setup.order_flat(path, &flat.points, &attributes, &mut self.cloud, &mut self.report)?;
+                    }
+                }
                 self.ordered = true;
                 Ok(read_ms)
             }

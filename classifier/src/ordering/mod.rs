@@ -26,6 +26,7 @@
 pub mod beam_table;
 mod buffer;
 pub mod calibration;
+mod input_point;
 pub mod organized;
 pub mod placement;
 pub(crate) mod polar;
@@ -40,6 +41,7 @@ use sim::{OrderedCloud, SemanticClass};
 pub use beam_table::{BeamTable, TableRows};
 pub use buffer::CloudBuffer;
 pub use calibration::{Calibration, CalibrationError};
+pub use input_point::InputPoint;
 pub use organized::{order_organized, order_organized_in_place, read_organized_into};
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};
@@ -68,8 +70,8 @@ pub enum PathChoice {
 /// Orders `points_in_sensor` into the grid of `table`, by unfolding or the beam table as `choice`
 /// allows; points go to the vehicle frame through `vehicle_from_sensor`. Every usable point gets a
 /// cell ([`OrderingReport::cell_of_point`]).
-pub fn order_cloud(
-    points_in_sensor: &[Vec3],
+pub fn order_cloud<P: InputPoint>(
+    points_in_sensor: &[P],
     attributes: &PointAttributes<'_>,
     table: &BeamTable,
     vehicle_from_sensor: Affine3A,
@@ -95,8 +97,8 @@ pub fn order_cloud(
 /// the fields it never fills ([`CloudBuffer`]). On an error `report` is not meaningful and the
 /// cloud is the previous one.
 #[allow(clippy::too_many_arguments)]
-pub fn order_cloud_into(
-    points_in_sensor: &[Vec3],
+pub fn order_cloud_into<P: InputPoint>(
+    points_in_sensor: &[P],
     attributes: &PointAttributes<'_>,
     table: &BeamTable,
     vehicle_from_sensor: Affine3A,

@@ -12,6 +12,7 @@ use sim::cloud::KnownFields;
 use sim::{OrderedCloud, SemanticClass};
 
 use super::buffer::CloudBuffer;
+use super::input_point::InputPoint;
 use super::report::OrderingReport;
 use super::usable::Usable;
 
@@ -38,7 +39,8 @@ pub(crate) struct Wish {
 /// The per-point attributes carried into the cloud.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PointAttributes<'a> {
-    /// Intensity per input point.
+    /// Intensity per input point (where `None`, points that carry an intensity, such as KITTI
+    /// records, give their own).
     pub intensity: Option<&'a [f32]>,
     /// Semantic label per input point (makes `label` and `ground`).
     pub labels: Option<&'a [SemanticClass]>,
@@ -263,8 +265,8 @@ impl Stacked {
 /// Builds the cloud into `cloud` (its buffers reused): the usable points in their cells (`cell_of_usable`), moved to the vehicle
 /// frame by `vehicle_from_sensor`; every cell's `ring` is its row and `column` its column.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn build_cloud(
-    points_in_sensor: &[Vec3],
+pub(crate) fn build_cloud<P: InputPoint>(
+    points_in_sensor: &[P],
     attributes: &PointAttributes<'_>,
     usable: &Usable,
     cell_of_usable: &[u32],
@@ -322,9 +324,9 @@ pub(crate) fn build_cloud(
 /// Writes the points (usable point `i` is input point `point(i)`, its cell `cells[i]`) and their
 /// attributes into `cloud`'s cells, last point first.
 #[inline(always)]
-fn scatter(
+fn scatter<P: InputPoint>(
     cloud: &mut OrderedCloud,
-    points_in_sensor: &[Vec3],
+    points_in_sensor: &[P],
     attributes: &PointAttributes<'_>,
     cells: &[u32],
     transform: Option<Affine3A>,
@@ -341,11 +343,14 @@ fn scatter(
     };
     // One loop per case, so that no case is tested per point.
     let t = transform.unwrap_or(Affine3A::IDENTITY);
-    match (transform.is_some(), attributes.intensity) {
-        (false, None) => scatter_points::<false, false>(fields, points_in_sensor, &[], cells, t, &point),
-        (false, Some(v)) => scatter_points::<false, true>(fields, points_in_sensor, v, cells, t, &point),
-        (true, None) => scatter_points::<true, false>(fields, points_in_sensor, &[], cells, t, &point),
-        (true, Some(v)) => scatter_points::<true, true>(fields, points_in_sensor, v, cells, t, &point),
+    // Intensities: the attributes', else the points' own (KITTI records), else none written.
+    match (transform.is_some(), attributes.intensity, P::HAS_INTENSITY) {
+        (false, None, false) => scatter_points::<P, false, false, false>(fields, points_in_sensor, &[], cells, t, &point),
+        (false, None, true) => scatter_points::<P, false, false, true>(fields, points_in_sensor, &[], cells, t, &point),
+        (false, Some(v), _) => scatter_points::<P, false, true, false>(fields, points_in_sensor, v, cells, t, &point),
+        (true, None, false) => scatter_points::<P, true, false, false>(fields, points_in_sensor, &[], cells, t, &point),
+        (true, None, true) => scatter_points::<P, true, false, true>(fields, points_in_sensor, &[], cells, t, &point),
+        (true, Some(v), _) => scatter_points::<P, true, true, false>(fields, points_in_sensor, v, cells, t, &point),
     }
     if let Some(t) = attributes.time_s {
         for (i, &cell) in cells.iter().enumerate().rev() {
@@ -368,12 +373,12 @@ struct Fields<'a> {
     intensity: &'a mut [f32],
 }
 
-/// [`scatter`]'s points, ranges, sensors and (where `INTENSITY`) intensities, transformed by `t`
-/// where `TRANSFORM`.
+/// [`scatter`]'s points, ranges, sensors and intensities (from `intensity_in` where `INTENSITY`,
+/// from the points where `OWN_INTENSITY`), transformed by `t` where `TRANSFORM`.
 #[inline(always)]
-fn scatter_points<const TRANSFORM: bool, const INTENSITY: bool>(
+fn scatter_points<P: InputPoint, const TRANSFORM: bool, const INTENSITY: bool, const OWN_INTENSITY: bool>(
     fields: Fields<'_>,
-    points_in_sensor: &[Vec3],
+    points_in_sensor: &[P],
     intensity_in: &[f32],
     cells: &[u32],
     t: Affine3A,
@@ -389,12 +394,15 @@ fn scatter_points<const TRANSFORM: bool, const INTENSITY: bool>(
             // Never: every cell is one of the grid's, every index one of the points'.
             continue;
         }
-        let p = points_in[k];
+        let q = points_in[k];
+        let p = q.xyz();
         fields.points[cell] = if TRANSFORM { t.transform_point3(p) } else { p };
         fields.range[cell] = p.length();
         fields.sensor[cell] = 0;
         if INTENSITY {
             fields.intensity[cell] = intensity_in[k];
+        } else if OWN_INTENSITY {
+            fields.intensity[cell] = q.intensity().unwrap_or(0.0);
         }
     }
 }

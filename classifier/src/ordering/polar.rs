@@ -3,7 +3,7 @@
 //! cost about 1 ms of a 124 k-point KITTI frame. The azimuth is [`fast_atan2`]'s, bit for bit:
 //! the same operations in the same order, its branches written as selects.
 
-use glam::Vec3;
+use super::input_point::InputPoint;
 
 #[cfg(test)]
 use super::beam_table::fast_atan2;
@@ -14,7 +14,7 @@ const LANES: usize = 16;
 /// `(azimuth_rad, horizontal_distance_m, tan_elevation)` of `points[k]` for every `k` in `valid`
 /// (every point where `valid` is `None`), in that order; `tan_elevation` is seen from the sensor
 /// origin (`z / max(d, 1e-6)`).
-pub(crate) fn polar(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+pub(crate) fn polar<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
@@ -29,12 +29,12 @@ pub(crate) fn polar(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f3
 /// [`polar_body`] compiled for AVX2 (plain IEEE operations only: the same bits as without it).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn polar_avx2(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+fn polar_avx2<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     polar_body(points, valid)
 }
 
 #[inline(always)]
-fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     let m = valid.map_or(points.len(), <[u32]>::len);
     // Filled lane block by lane block (not zeroed first: that `memset` cost 0.1 ms a KITTI frame).
     let (mut az, mut dist, mut fine) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::with_capacity(m));
@@ -44,12 +44,13 @@ fn polar_body(points: &[Vec3], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Ve
         match valid {
             Some(valid) => {
                 for (l, &k) in valid[j * LANES..j * LANES + n].iter().enumerate() {
-                    let p = points[k as usize];
+                    let p = points[k as usize].xyz();
                     (x[l], y[l], z[l]) = (p.x, p.y, p.z);
                 }
             }
             None => {
                 for (l, p) in points[j * LANES..j * LANES + n].iter().enumerate() {
+                    let p = p.xyz();
                     (x[l], y[l], z[l]) = (p.x, p.y, p.z);
                 }
             }
@@ -91,6 +92,8 @@ pub(crate) fn atan2_lane(y: f32, x: f32) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    use glam::Vec3;
+
     use super::*;
 
     #[test]

@@ -3,23 +3,22 @@
 //! ([`TableRows::nearest_row`]); its column is the beam azimuth ([`TableRows::beam_azimuth`]).
 //! Points beyond the table's lowest or highest beam stay in the edge row and are counted.
 
-use glam::Vec3;
-
 use super::beam_table::TableRows;
+use super::input_point::InputPoint;
 use super::placement::Wish;
 use super::report::OrderingReport;
 use super::usable::Usable;
 
 /// The wish of every usable point from the table alone.
-pub(crate) fn table_wishes(
-    points: &[Vec3],
+pub(crate) fn table_wishes<P: InputPoint>(
+    points: &[P],
     usable: &Usable,
     rows: &TableRows,
     report: &mut OrderingReport,
 ) -> Vec<Wish> {
     let mut wishes = Vec::with_capacity(usable.len());
     for k in usable.iter() {
-        let p = points[k as usize];
+        let p = points[k as usize].xyz();
         let (row, _, outside) = rows.nearest_row(p);
         report.outside += usize::from(outside);
         let steps = rows.column_steps(rows.beam_azimuth(p, row));
@@ -32,8 +31,8 @@ pub(crate) fn table_wishes(
 /// top-first as the rings' median elevations go (ring 0 at the bottom for velodyne, at the top for
 /// ouster); columns from the beam azimuth. Refused for a ring value beyond the table's rows, or a
 /// way up that cannot be told (fewer than two rings with points, or no difference in elevation).
-pub(crate) fn ring_wishes(
-    points: &[Vec3],
+pub(crate) fn ring_wishes<P: InputPoint>(
+    points: &[P],
     usable: &Usable,
     rings: &[u16],
     rows: &TableRows,
@@ -46,7 +45,7 @@ pub(crate) fn ring_wishes(
         if g >= n {
             return Err(format!("point {k} has ring {g}, out of range 0 ..= {} (the beam table's rows)", n - 1));
         }
-        let p = points[k as usize];
+        let p = points[k as usize].xyz();
         sums[g].0 += f64::from(rows.rough_tan(p));
         sums[g].1 += 1;
     }
@@ -76,7 +75,7 @@ pub(crate) fn ring_wishes(
     for k in usable.iter() {
         let g = rings[k as usize] as usize;
         let row = if bottom_first { g } else { n - 1 - g };
-        let p = points[k as usize];
+        let p = points[k as usize].xyz();
         wishes.push(Wish { row: row as u32, steps: rows.column_steps(rows.beam_azimuth(p, row)) });
     }
     Ok(wishes)

@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use super::MAX_BAD_FRACTION;
+use super::input_point::InputPoint;
 use super::report::OrderingReport;
 use crate::error::{ClassifyError, Result};
 
@@ -21,7 +22,7 @@ pub(crate) struct Usable {
 
 impl Usable {
     /// Finds the usable points of `points`, counting bad points and no-returns in `report`.
-    pub(crate) fn find(points: &[Vec3], report: &mut OrderingReport) -> Result<Self> {
+    pub(crate) fn find<P: InputPoint>(points: &[P], report: &mut OrderingReport) -> Result<Self> {
         if points.len() > u32::MAX as usize / 2 {
             return Err(ClassifyError::Ordering(format!("{} points are too many", points.len())));
         }
@@ -41,7 +42,10 @@ impl Usable {
             return Ok(Self { idx: None, len: points.len() });
         }
         let idx: Vec<u32> = (0..points.len() as u32)
-            .filter(|&k| points[k as usize].is_finite() && points[k as usize] != Vec3::ZERO)
+            .filter(|&k| {
+                let p = points[k as usize].xyz();
+                p.is_finite() && p != Vec3::ZERO
+            })
             .collect();
         Ok(Self { len: idx.len(), idx: Some(idx) })
     }
@@ -73,7 +77,7 @@ impl Usable {
 
 /// Points with a non-finite coordinate and points at (0, 0, 0), counted (compiled for AVX2
 /// where the CPU has it: the same counts, about half the instructions of the baseline build).
-fn count_bad_and_zero(points: &[Vec3]) -> (usize, usize) {
+fn count_bad_and_zero<P: InputPoint>(points: &[P]) -> (usize, usize) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
@@ -88,15 +92,16 @@ fn count_bad_and_zero(points: &[Vec3]) -> (usize, usize) {
 /// [`count_body`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn count_avx2(points: &[Vec3]) -> (usize, usize) {
+fn count_avx2<P: InputPoint>(points: &[P]) -> (usize, usize) {
     count_body(points)
 }
 
 /// The body of [`count_bad_and_zero`], inlined into each instruction-set variant.
 #[inline(always)]
-fn count_body(points: &[Vec3]) -> (usize, usize) {
+fn count_body<P: InputPoint>(points: &[P]) -> (usize, usize) {
     let (mut bad, mut zero) = (0usize, 0usize);
     for p in points {
+        let p = p.xyz();
         let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
         bad += usize::from(!finite);
         zero += usize::from((p.x == 0.0) & (p.y == 0.0) & (p.z == 0.0));

@@ -153,6 +153,48 @@ pub fn points_from_bytes_into(
     out.points.reserve(n);
     out.intensity.reserve(n);
     decode_records(bin, &mut out.points, &mut out.intensity);
+    decode_labels(label, out);
+    Ok(())
+}
+
+/// The records of KITTI `.bin` bytes where they lie, for a reader that takes them so (ordering:
+/// `classifier::ordering::InputPoint`): `Some(records)`, `x y z intensity` per point as a view of
+/// `bin` (no copy), where `bin` is 4-byte aligned on a little-endian machine; otherwise `None`,
+/// with the points and intensities decoded into `out` as [`points_from_bytes_into`] decodes them.
+/// The `.label`'s classes go to `out.labels` either way; lengths are checked as in [`read_bytes`].
+///
+/// ```
+/// # use std::path::Path;
+/// let mut bin = Vec::new();
+/// for v in [1.0f32, 2.0, 3.0, 0.5, -1.0, 0.0, 4.0, 0.25] {
+///     bin.extend_from_slice(&v.to_le_bytes());
+/// }
+/// let mut out = sim::io::kitti::KittiPoints::default();
+/// match sim::io::kitti::records_or_points_into(Path::new("f.bin"), &bin, None, &mut out).unwrap() {
+///     Some(records) => assert_eq!(records, &[[1.0, 2.0, 3.0, 0.5], [-1.0, 0.0, 4.0, 0.25]]),
+///     None => assert_eq!(out.intensity, [0.5, 0.25]),
+/// }
+/// ```
+pub fn records_or_points_into<'a>(
+    bin_path: &Path,
+    bin: &'a [u8],
+    label: Option<(&Path, &[u8])>,
+    out: &mut KittiPoints,
+) -> Result<Option<&'a [[f32; 4]]>> {
+    check_lengths(bin_path, bin, label)?;
+    let in_place = if cfg!(target_endian = "little") { bytemuck::try_cast_slice::<u8, [f32; 4]>(bin).ok() } else { None };
+    let Some(records) = in_place else {
+        points_from_bytes_into(bin_path, bin, label, out)?;
+        return Ok(None);
+    };
+    out.points.clear();
+    out.intensity.clear();
+    decode_labels(label, out);
+    Ok(Some(records))
+}
+
+/// Decodes the `.label`'s classes (low 16 bits) into `out.labels`, or sets it to `None`.
+fn decode_labels(label: Option<(&Path, &[u8])>, out: &mut KittiPoints) {
     match label {
         Some((_, lb)) => {
             let labels = out.labels.get_or_insert_with(Vec::new);
@@ -164,7 +206,6 @@ pub fn points_from_bytes_into(
         }
         None => out.labels = None,
     }
-    Ok(())
 }
 
 /// Appends the points and intensities of the 16-byte records of `bin` (compiled for AVX2 where

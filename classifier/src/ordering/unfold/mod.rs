@@ -31,9 +31,8 @@
 mod columns;
 mod rings;
 
-use glam::Vec3;
-
 use super::beam_table::TableRows;
+use super::input_point::InputPoint;
 use super::placement::Wish;
 use super::report::OrderingReport;
 use super::usable::Usable;
@@ -173,8 +172,8 @@ pub(crate) fn match_rows(medians: &[f32], rows: &TableRows, params: &UnfoldParam
 
 /// Unfolds the usable points (`usable`, of `points`): their rings, rows and columns, or why the
 /// order does not unfold.
-pub(crate) fn unfold(
-    points: &[Vec3],
+pub(crate) fn unfold<P: InputPoint>(
+    points: &[P],
     usable: &Usable,
     rows: &TableRows,
     params: &UnfoldParams,
