@@ -123,7 +123,21 @@ pub fn order_cloud_into<P: InputPoint>(
     let mut cell_of_point = std::mem::take(&mut report.cell_of_point);
     cell_of_point.resize(n, None);
     *report = OrderingReport { cell_of_point, ..OrderingReport::default() };
-    let usable = Usable::find(points_in_sensor, report)?;
+    // Where the points may unfold, the polar pass over every point also counts the unusable ones:
+    // the points are read once.
+    let (usable, mut polar) = if attributes.rings.is_none() && choice != PathChoice::BeamTable {
+        Usable::check_count(n)?;
+        let (polar, counts) = polar::polar_counting(points_in_sensor, None);
+        let usable = Usable::from_counts(points_in_sensor, counts, report)?;
+        // With unusable points, the polar values of the usable ones only (rare).
+        let polar = match usable.indices() {
+            None => polar,
+            Some(idx) => polar::polar(points_in_sensor, Some(idx)),
+        };
+        (usable, Some(polar))
+    } else {
+        (Usable::find(points_in_sensor, report)?, None)
+    };
     let place = |wishes: Vec<placement::Wish>, report: &mut OrderingReport| {
         placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, report)
     };
@@ -139,7 +153,8 @@ pub fn order_cloud_into<P: InputPoint>(
             place(table::table_wishes(points_in_sensor, &usable, &rows, report), report)
         }
         (None, PathChoice::Unfold | PathChoice::Auto) => {
-            match unfold::unfold(points_in_sensor, &usable, &rows, params, report) {
+            let polar = polar.take().unwrap_or_else(|| polar::polar(points_in_sensor, usable.indices()));
+            match unfold::unfold(points_in_sensor, &usable, polar, &rows, params, report) {
                 Ok(Unfolded::Wishes(wishes)) => {
                     report.path = OrderingPath::Unfolded;
                     place(wishes, report)

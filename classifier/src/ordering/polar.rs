@@ -1,7 +1,9 @@
 //! Azimuth, horizontal distance and `tan(elevation)` of every usable point of a cloud in one pass
 //! that the compiler vectorizes: the first step of scan unfolding, where a per-point scalar loop
 //! cost about 1 ms of a 124 k-point KITTI frame. The azimuth is [`fast_atan2`]'s, bit for bit:
-//! the same operations in the same order, its branches written as selects.
+//! the same operations in the same order, its branches written as selects. Over every point of a
+//! cloud the same pass counts the bad points and no-returns ([`super::usable`]), so that the
+//! points are read once where all of them are usable (the common case).
 
 use super::input_point::InputPoint;
 
@@ -11,10 +13,19 @@ use super::beam_table::fast_atan2;
 /// Points gathered and computed together.
 const LANES: usize = 16;
 
+/// The azimuth (rad), horizontal distance (m) and `tan(elevation)` of points, one per point.
+pub(crate) type Polar = (Vec<f32>, Vec<f32>, Vec<f32>);
+
 /// `(azimuth_rad, horizontal_distance_m, tan_elevation)` of `points[k]` for every `k` in `valid`
 /// (every point where `valid` is `None`), in that order; `tan_elevation` is seen from the sensor
 /// origin (`z / max(d, 1e-6)`).
-pub(crate) fn polar<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+pub(crate) fn polar<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> Polar {
+    polar_counting(points, valid).0
+}
+
+/// [`polar`] and the counts of the points read that have a non-finite coordinate and of those at
+/// (0, 0, 0), as [`super::usable`] counts them.
+pub(crate) fn polar_counting<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (usize, usize)) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
@@ -29,17 +40,20 @@ pub(crate) fn polar<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<
 /// [`polar_body`] compiled for AVX2 (plain IEEE operations only: the same bits as without it).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn polar_avx2<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+fn polar_avx2<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (usize, usize)) {
     polar_body(points, valid)
 }
 
 #[inline(always)]
-fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (usize, usize)) {
     let m = valid.map_or(points.len(), <[u32]>::len);
     // Filled lane block by lane block (not zeroed first: that `memset` cost 0.1 ms a KITTI frame).
     let (mut az, mut dist, mut fine) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::with_capacity(m));
+    // Per lane: points with a non-finite coordinate, points at (0, 0, 0).
+    let (mut bad, mut zero) = ([0u32; LANES], [0u32; LANES]);
     for j in 0..m.div_ceil(LANES) {
-        let (mut x, mut y, mut z) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
+        // Lanes past the last point hold (1, 1, 1): counted as neither.
+        let (mut x, mut y, mut z) = ([1f32; LANES], [1f32; LANES], [1f32; LANES]);
         let n = LANES.min(m - j * LANES);
         match valid {
             Some(valid) => {
@@ -57,6 +71,8 @@ fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, 
         }
         let (mut oa, mut od, mut of) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
         for l in 0..LANES {
+            bad[l] += u32::from(!(x[l].is_finite() & y[l].is_finite() & z[l].is_finite()));
+            zero[l] += u32::from((x[l] == 0.0) & (y[l] == 0.0) & (z[l] == 0.0));
             oa[l] = atan2_lane(y[l], x[l]);
             od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
             of[l] = z[l] / od[l].max(1e-6);
@@ -65,7 +81,8 @@ fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Vec<f32>, 
         dist.extend_from_slice(&od[..n]);
         fine.extend_from_slice(&of[..n]);
     }
-    (az, dist, fine)
+    let total = |c: [u32; LANES]| c.iter().map(|&c| c as usize).sum::<usize>();
+    ((az, dist, fine), (total(bad), total(zero)))
 }
 
 /// [`fast_atan2`] with its branches as selects (it vectorizes); the same bits for every input.
@@ -124,6 +141,18 @@ mod tests {
             assert_eq!(dist[j].to_bits(), d.to_bits());
             assert_eq!(fine[j].to_bits(), (p.z / d.max(1e-6)).to_bits());
         }
+        // The counts of a pass over every point: bad points and no-returns, none in the padding
+        // lanes of a last partial block (the cloud's length is not a multiple of the lanes).
+        let mut odd = pts[..1001].to_vec();
+        odd[3] = Vec3::new(f32::NAN, 1.0, 1.0);
+        odd[17] = Vec3::new(1.0, f32::NEG_INFINITY, 1.0);
+        odd[18] = Vec3::new(1.0, 1.0, f32::INFINITY);
+        odd[500] = Vec3::ZERO;
+        odd[1000] = Vec3::new(0.0, -0.0, 0.0);
+        assert_eq!(polar_counting(&odd, None).1, (3, 2));
+        assert_eq!(polar_counting(&odd[..999], None).1, (3, 1));
+        let (polar_all, counts) = polar_counting(&pts, None);
+        assert_eq!((polar_all.0.len(), counts), (pts.len(), (0, 0)));
         // Spot values against libm.
         let (az, _, _) = polar(&[Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, -2.0, 0.0), Vec3::new(1.0, 1.0, 0.0)], None);
         assert!((az[0] - std::f32::consts::PI).abs() < 1e-6);

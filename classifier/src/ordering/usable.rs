@@ -23,11 +23,26 @@ pub(crate) struct Usable {
 impl Usable {
     /// Finds the usable points of `points`, counting bad points and no-returns in `report`.
     pub(crate) fn find<P: InputPoint>(points: &[P], report: &mut OrderingReport) -> Result<Self> {
-        if points.len() > u32::MAX as usize / 2 {
-            return Err(ClassifyError::Ordering(format!("{} points are too many", points.len())));
-        }
+        Self::check_count(points.len())?;
         // A counting pass without branches (it vectorizes); the index list only where needed.
-        let (bad, zero) = count_bad_and_zero(points);
+        Self::from_counts(points, count_bad_and_zero(points), report)
+    }
+
+    /// Refuses clouds of more points than the cells' `u32` indices can hold.
+    pub(crate) fn check_count(n: usize) -> Result<()> {
+        if n > u32::MAX as usize / 2 {
+            return Err(ClassifyError::Ordering(format!("{n} points are too many")));
+        }
+        Ok(())
+    }
+
+    /// The usable points of `points` from the counts of their bad points and no-returns, made by
+    /// a pass that read every point (the polar pass of scan unfolding reads them once for both).
+    pub(crate) fn from_counts<P: InputPoint>(
+        points: &[P],
+        (bad, zero): (usize, usize),
+        report: &mut OrderingReport,
+    ) -> Result<Self> {
         report.skipped += bad;
         report.no_returns += zero;
         if report.skipped as f64 > MAX_BAD_FRACTION * points.len() as f64 {

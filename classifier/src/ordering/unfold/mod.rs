@@ -170,16 +170,17 @@ pub(crate) fn match_rows(medians: &[f32], rows: &TableRows, params: &UnfoldParam
     best.map(|b| b.1).ok_or_else(|| "the rings' median elevations do not step through the beam table".to_string())
 }
 
-/// Unfolds the usable points (`usable`, of `points`): their rings, rows and columns, or why the
-/// order does not unfold.
+/// Unfolds the usable points (`usable`, of `points`, whose [`super::polar::polar`] values are
+/// `polar`): their rings, rows and columns, or why the order does not unfold.
 pub(crate) fn unfold<P: InputPoint>(
     points: &[P],
     usable: &Usable,
+    polar: super::polar::Polar,
     rows: &TableRows,
     params: &UnfoldParams,
     report: &mut OrderingReport,
 ) -> Result<Unfolded, String> {
-    let (az, dist, mut fine) = super::polar::polar(points, usable.indices());
+    let (az, dist, mut fine) = polar;
     if rows.horizontal_m.iter().chain(&rows.vertical_m).any(|&x| x != 0.0) {
         // With origin offsets, the elevation seen from the nearest beam's origin; without them the
         // elevation seen from the sensor origin is exact enough.
