@@ -282,7 +282,9 @@ fn records_order_as_points_with_intensities() {
         assert_eq!(got_report, want_report);
         assert_eq!(got.intensity, want.intensity);
         assert_eq!(got.label, want.label);
-        let bits = |c: &sim::OrderedCloud| c.point_in_vehicle.iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        let bits = |c: &sim::OrderedCloud| {
+            c.point_in_vehicle.iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>()
+        };
         assert_eq!(bits(&got), bits(&want));
         assert!(got.intensity.iter().filter(|&&i| i > 0.0).count() > n / 2);
     }

@@ -299,8 +299,11 @@ fn kitti_records_in_place_or_decoded_agree() {
     // Aligned (a `Vec<u32>`'s bytes) and one byte off.
     let words: Vec<u32> = bin.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
     let aligned: &[u8] = bytemuck::cast_slice(&words);
-    let mut shifted = vec![0u8];
-    shifted.extend_from_slice(&bin);
+    // The same bytes starting one byte past a 4-byte boundary.
+    let mut shifted = vec![0u8; bin.len() + 4];
+    let start = (4 - shifted.as_ptr() as usize % 4) % 4 + 1;
+    shifted[start..start + bin.len()].copy_from_slice(&bin);
+    let misaligned = &shifted[start..start + bin.len()];
     let mut out = kitti::KittiPoints::default();
     let records = kitti::records_or_points_into(bp, aligned, Some((lp, &label)), &mut out).unwrap().expect("in place");
     assert_eq!(records.len(), n);
@@ -308,12 +311,10 @@ fn kitti_records_in_place_or_decoded_agree() {
         assert_eq!((Vec3::new(r[0], r[1], r[2]), r[3]), (want.points[k], want.intensity[k]), "record {k}");
     }
     assert!(out.points.is_empty() && out.labels == want.labels);
-    let misaligned = &shifted[1..];
-    if misaligned.as_ptr() as usize % 4 != 0 {
-        let got = kitti::records_or_points_into(bp, misaligned, Some((lp, &label)), &mut out).unwrap();
-        assert!(got.is_none());
-        assert_eq!(out, want);
-    }
+    assert_eq!(misaligned.as_ptr() as usize % 4, 1);
+    let got = kitti::records_or_points_into(bp, misaligned, Some((lp, &label)), &mut out).unwrap();
+    assert!(got.is_none());
+    assert_eq!(out, want);
     let m = bad_file_message(kitti::records_or_points_into(bp, &aligned[..70], None, &mut out).unwrap_err(), bp);
     assert!(m.contains("not a multiple of 16"), "{m}");
     let m = bad_file_message(

@@ -280,7 +280,8 @@ impl FrameReader {
                         setup.order_flat(path, records, &attributes, &mut self.cloud, &mut self.report)?;
                     }
                     None => {
-                        let attributes = PointAttributes { intensity: Some(&flat.intensity), labels, ..PointAttributes::default() };
+                        let attributes =
+                            PointAttributes { intensity: Some(&flat.intensity), labels, ..PointAttributes::default() };
                         setup.order_flat(path, &flat.points, &attributes, &mut self.cloud, &mut self.report)?;
                     }
                 }

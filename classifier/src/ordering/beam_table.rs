@@ -287,7 +287,13 @@ impl TableRows {
     /// `points[valid[i]]` (every point where `valid` is `None`) into `out[i]`, the same bits;
     /// `dist[i]` is the point's horizontal distance `sqrt(x * x + y * y)`. Two passes: the
     /// divisions vectorized, then the row search.
-    pub(crate) fn fine_tans<P: super::InputPoint>(&self, points: &[P], valid: Option<&[u32]>, dist: &[f32], out: &mut [f32]) {
+    pub(crate) fn fine_tans<P: super::InputPoint>(
+        &self,
+        points: &[P],
+        valid: Option<&[u32]>,
+        dist: &[f32],
+        out: &mut [f32],
+    ) {
         let (n, tan, mean_v) = (self.len(), &self.tan_elevation[..], self.mean_vertical_m);
         let (h, v) = (&self.horizontal_m[..n], &self.vertical_m[..n]);
         let z = |i: usize| valid.map_or(points[i], |valid| points[valid[i] as usize]).xyz().z;

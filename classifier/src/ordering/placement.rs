@@ -345,7 +345,9 @@ fn scatter<P: InputPoint>(
     let t = transform.unwrap_or(Affine3A::IDENTITY);
     // Intensities: the attributes', else the points' own (KITTI records), else none written.
     match (transform.is_some(), attributes.intensity, P::HAS_INTENSITY) {
-        (false, None, false) => scatter_points::<P, false, false, false>(fields, points_in_sensor, &[], cells, t, &point),
+        (false, None, false) => {
+            scatter_points::<P, false, false, false>(fields, points_in_sensor, &[], cells, t, &point)
+        }
         (false, None, true) => scatter_points::<P, false, false, true>(fields, points_in_sensor, &[], cells, t, &point),
         (false, Some(v), _) => scatter_points::<P, false, true, false>(fields, points_in_sensor, v, cells, t, &point),
         (true, None, false) => scatter_points::<P, true, false, false>(fields, points_in_sensor, &[], cells, t, &point),

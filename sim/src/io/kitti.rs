@@ -182,7 +182,8 @@ pub fn records_or_points_into<'a>(
     out: &mut KittiPoints,
 ) -> Result<Option<&'a [[f32; 4]]>> {
     check_lengths(bin_path, bin, label)?;
-    let in_place = if cfg!(target_endian = "little") { bytemuck::try_cast_slice::<u8, [f32; 4]>(bin).ok() } else { None };
+    let in_place =
+        if cfg!(target_endian = "little") { bytemuck::try_cast_slice::<u8, [f32; 4]>(bin).ok() } else { None };
     let Some(records) = in_place else {
         points_from_bytes_into(bin_path, bin, label, out)?;
         return Ok(None);
