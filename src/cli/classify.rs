@@ -221,7 +221,7 @@ impl FrameReader {
     }
 
     /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
-    /// ordering; for a driver's organized PCD, decoded in order, only the mapping and the header).
+    /// ordering; for a driver's organized PCD, decoded in order, only the file's read and the header).
     pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> anyhow::Result<f64> {
         let t0 = std::time::Instant::now();
         self.ordered = false;
@@ -232,7 +232,7 @@ impl FrameReader {
                 let (info, (rows, _, planes)) = (frame.info(), frame.shape());
                 if info.organized && !info.ours && planes == 1 {
                     // A driver's organized cloud: its rows are put in order as it is decoded, so
-                    // `read_ms` is the mapping and the header, the rest counts as ordering.
+                    // `read_ms` is the file's read and the header, the rest counts as ordering.
                     let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                     if let Some(n) = setup.calibrated_lasers
                         && n != rows

@@ -63,9 +63,19 @@ fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (us
                 }
             }
             None => {
-                for (l, p) in points[j * LANES..j * LANES + n].iter().enumerate() {
-                    let p = p.xyz();
-                    (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+                let block = &points[j * LANES..j * LANES + n];
+                // A whole block as an array: a loop of known length, which the compiler unrolls
+                // into vector loads and shuffles.
+                if let Ok(whole) = <&[P; LANES]>::try_from(block) {
+                    for l in 0..LANES {
+                        let p = whole[l].xyz();
+                        (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+                    }
+                } else {
+                    for (l, p) in block.iter().enumerate() {
+                        let p = p.xyz();
+                        (x[l], y[l], z[l]) = (p.x, p.y, p.z);
+                    }
                 }
             }
         }
