@@ -21,6 +21,10 @@ struct Page([u8; PAGE_BYTES]);
 /// Bytes per [`Page`].
 const PAGE_BYTES: usize = 4096;
 
+/// Largest input file read (4 GiB): a LiDAR frame is a few megabytes (an OS1-128 x 2,048 PCD about
+/// 20 MB), so a larger file is refused rather than read whole into memory.
+const MAX_FILE_BYTES: usize = 4 << 30;
+
 /// The bytes of the last file loaded, in a page-aligned buffer reused from file to file.
 #[derive(Default)]
 pub struct InputBytes {
@@ -37,10 +41,21 @@ impl InputBytes {
         let mut file = std::fs::File::open(path).map_err(io)?;
         // Room for the whole file and the read that finds its end, where the length is known.
         let expected = file.metadata().ok().filter(|m| m.is_file()).map_or(0, |m| m.len());
-        self.reserve(usize::try_from(expected).unwrap_or(usize::MAX).saturating_add(1));
+        let too_large = |len: u64| {
+            sim::SimError::bad_file(
+                path,
+                format!("{len} bytes: larger than the {MAX_FILE_BYTES} bytes a frame file may have"),
+            )
+        };
+        let expected =
+            usize::try_from(expected).ok().filter(|&n| n <= MAX_FILE_BYTES).ok_or_else(|| too_large(expected))?;
+        self.reserve(path, expected + 1)?;
         loop {
             if self.len == self.pages.len() * PAGE_BYTES {
-                self.reserve(self.len.saturating_mul(2).max(PAGE_BYTES));
+                if self.len >= MAX_FILE_BYTES {
+                    return Err(too_large(self.len as u64));
+                }
+                self.reserve(path, (self.len * 2).clamp(PAGE_BYTES, MAX_FILE_BYTES))?;
             }
             let free = &mut bytemuck::cast_slice_mut::<Page, u8>(&mut self.pages)[self.len..];
             match file.read(free) {
@@ -53,12 +68,17 @@ impl InputBytes {
         Ok(&bytemuck::cast_slice::<Page, u8>(&self.pages)[..self.len])
     }
 
-    /// Grows the buffer to hold at least `bytes` (pages are zeroed once, when first added).
-    fn reserve(&mut self, bytes: usize) {
+    /// Grows the buffer to hold at least `bytes` (pages are zeroed once, when first added); an
+    /// allocation that fails is an error naming `path`, not an abort.
+    fn reserve(&mut self, path: &Path, bytes: usize) -> Result<(), sim::SimError> {
         let pages = bytes.div_ceil(PAGE_BYTES);
         if pages > self.pages.len() {
+            self.pages.try_reserve_exact(pages - self.pages.len()).map_err(|e| {
+                sim::SimError::io(path, std::io::Error::new(std::io::ErrorKind::OutOfMemory, e.to_string()))
+            })?;
             self.pages.resize(pages, Page([0; PAGE_BYTES]));
         }
+        Ok(())
     }
 }
 
@@ -79,6 +99,11 @@ mod tests {
             assert_eq!(got, bytes.as_slice(), "{len} bytes");
             assert_eq!(got.as_ptr() as usize % PAGE_BYTES, 0, "aligned at {len} bytes");
         }
+        // A sparse file past the limit is refused from its length, before any read.
+        let huge = dir.path().join("huge.bin");
+        std::fs::File::create(&huge).and_then(|f| f.set_len((MAX_FILE_BYTES + 1) as u64)).expect("sparse file");
+        let err = input.load(&huge).expect_err("too large").to_string();
+        assert!(err.contains("huge.bin") && err.contains("larger than"), "{err}");
         let missing = dir.path().join("missing.pcd");
         let err = input.load(&missing).expect_err("a missing file is an error");
         assert!(err.to_string().contains("missing.pcd"), "{err}");
