@@ -6,6 +6,7 @@
 //! points are read once where all of them are usable (the common case).
 
 use super::input_point::InputPoint;
+use super::usable::bad_and_no_return;
 
 #[cfg(test)]
 use super::beam_table::fast_atan2;
@@ -81,8 +82,9 @@ fn polar_body<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (us
         }
         let (mut oa, mut od, mut of) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
         for l in 0..LANES {
-            bad[l] += u32::from(!(x[l].is_finite() & y[l].is_finite() & z[l].is_finite()));
-            zero[l] += u32::from((x[l] == 0.0) & (y[l] == 0.0) & (z[l] == 0.0));
+            let (is_bad, is_zero) = bad_and_no_return(x[l], y[l], z[l]);
+            bad[l] += u32::from(is_bad);
+            zero[l] += u32::from(is_zero);
             oa[l] = atan2_lane(y[l], x[l]);
             od[l] = (x[l] * x[l] + y[l] * y[l]).sqrt();
             of[l] = z[l] / od[l].max(1e-6);

@@ -5,8 +5,6 @@
 //! Real files rarely hold either, so the common case keeps no index list at all: usable point `i`
 //! is input point `i` ([`Usable::point`]), and the passes over the points read them contiguously.
 
-use glam::Vec3;
-
 use super::MAX_BAD_FRACTION;
 use super::input_point::InputPoint;
 use super::report::OrderingReport;
@@ -59,7 +57,7 @@ impl Usable {
         let idx: Vec<u32> = (0..points.len() as u32)
             .filter(|&k| {
                 let p = points[k as usize].xyz();
-                p.is_finite() && p != Vec3::ZERO
+                bad_and_no_return(p.x, p.y, p.z) == (false, false)
             })
             .collect();
         Ok(Self { len: idx.len(), idx: Some(idx) })
@@ -90,6 +88,14 @@ impl Usable {
     }
 }
 
+/// Whether the point `(x, y, z)` is bad (a non-finite coordinate) and whether it is a no-return
+/// (at (0, 0, 0)): the definitions of every count and list of usable points (this module's, and
+/// the polar pass's), without branches so that the passes vectorize.
+#[inline(always)]
+pub(crate) fn bad_and_no_return(x: f32, y: f32, z: f32) -> (bool, bool) {
+    (!(x.is_finite() & y.is_finite() & z.is_finite()), (x == 0.0) & (y == 0.0) & (z == 0.0))
+}
+
 /// Points with a non-finite coordinate and points at (0, 0, 0), counted (compiled for AVX2
 /// where the CPU has it: the same counts, about half the instructions of the baseline build).
 fn count_bad_and_zero<P: InputPoint>(points: &[P]) -> (usize, usize) {
@@ -117,15 +123,17 @@ fn count_body<P: InputPoint>(points: &[P]) -> (usize, usize) {
     let (mut bad, mut zero) = (0usize, 0usize);
     for p in points {
         let p = p.xyz();
-        let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
-        bad += usize::from(!finite);
-        zero += usize::from((p.x == 0.0) & (p.y == 0.0) & (p.z == 0.0));
+        let (is_bad, is_zero) = bad_and_no_return(p.x, p.y, p.z);
+        bad += usize::from(is_bad);
+        zero += usize::from(is_zero);
     }
     (bad, zero)
 }
 
 #[cfg(test)]
 mod tests {
+    use glam::Vec3;
+
     use super::*;
 
     #[test]

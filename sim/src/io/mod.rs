@@ -17,5 +17,3 @@ pub mod pcd;
 pub mod ply;
 pub(crate) mod plyfile;
 mod read_util;
-
-pub use read_util::read_file_into;

@@ -9,20 +9,6 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|e| SimError::io(path, e))
 }
 
-/// Reads a whole file into `buf` (cleared first; its buffer is reused, so frames read one after
-/// another allocate nothing once it is large enough), mapping I/O errors to [`SimError::Io`]
-/// naming the file.
-pub fn read_file_into(path: &Path, buf: &mut Vec<u8>) -> Result<()> {
-    use std::io::Read;
-    buf.clear();
-    let mut file = std::fs::File::open(path).map_err(|e| SimError::io(path, e))?;
-    if let Ok(meta) = file.metadata() {
-        buf.reserve(usize::try_from(meta.len()).unwrap_or(0));
-    }
-    file.read_to_end(buf).map_err(|e| SimError::io(path, e))?;
-    Ok(())
-}
-
 /// Scalar types the binary formats use, with their byte size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Scalar {
