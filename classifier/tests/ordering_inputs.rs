@@ -31,6 +31,30 @@ fn kitti_like(cols: usize) -> (BeamTable, Vec<Vec3>, Vec<(usize, usize)>) {
     (table, pts, truth)
 }
 
+/// Every cell that one point of `pts` went to holds that point (through `vehicle_from_sensor`)
+/// and its range from the sensor, `|p|`, to the bit.
+fn assert_cells_hold_their_points(
+    cloud: &sim::OrderedCloud,
+    cell_of_point: &[Option<u32>],
+    pts: &[Vec3],
+    vehicle_from_sensor: Affine3A,
+) {
+    let mut count = vec![0u32; cloud.len()];
+    for c in cell_of_point.iter().flatten() {
+        count[*c as usize] += 1;
+    }
+    let mut checked = 0;
+    for (p, c) in pts.iter().zip(cell_of_point) {
+        let Some(c) = c.map(|c| c as usize) else { continue };
+        if count[c] == 1 {
+            assert_eq!(cloud.range_m[c].to_bits(), p.length().to_bits(), "range of {p:?}");
+            assert_eq!(cloud.point_in_vehicle[c], vehicle_from_sensor.transform_point3(*p));
+            checked += 1;
+        }
+    }
+    assert!(checked > pts.len() * 9 / 10, "{checked} of {} points checked", pts.len());
+}
+
 #[test]
 fn scan_order_unfolds_into_true_cells_despite_jitter_at_the_back() {
     let (table, mut pts, truth) = kitti_like(360);
@@ -53,6 +77,7 @@ fn scan_order_unfolds_into_true_cells_despite_jitter_at_the_back() {
         truth.iter().enumerate().filter(|&(k, &(r, c))| report.cell_of_point[k] == Some((r * 360 + c) as u32)).count();
     assert!(right >= pts.len() - 2, "{right} of {} in their true cell", pts.len());
     assert_eq!((cloud.rows, cloud.cols), (16, 360));
+    assert_cells_hold_their_points(&cloud, &report.cell_of_point, &pts, Affine3A::IDENTITY);
 }
 
 #[test]
@@ -88,6 +113,8 @@ fn shuffled_points_fall_back_to_the_beam_table_and_bad_points_are_counted() {
         .filter(|&k| report.cell_of_point[k] == Some((truth[order[k]].0 * 360 + truth[order[k]].1) as u32))
         .count();
     assert_eq!(right, n - 3);
+    // 5,757 usable points: the ranges' blocks of 8 and a partial one.
+    assert_cells_hold_their_points(&cloud, &report.cell_of_point, &shuffled, Affine3A::IDENTITY);
     let ground = vec![true; cloud.len()];
     let d = decisions_per_point(&report, &ground);
     assert_eq!((d[5], d[77], d[99], d[0]), (0, 0, 0, 1));
@@ -287,5 +314,6 @@ fn records_order_as_points_with_intensities() {
         };
         assert_eq!(bits(&got), bits(&want));
         assert!(got.intensity.iter().filter(|&&i| i > 0.0).count() > n / 2);
+        assert_cells_hold_their_points(&got, &got_report.cell_of_point, points, transform);
     }
 }
