@@ -164,6 +164,8 @@ pub struct ClusterWorkspace {
     bbox: Vec<(glam::Vec2, glam::Vec2)>,
     /// Candidate cells (cells with a cluster) in increasing order.
     members: Vec<u32>,
+    /// The members outside the largest cluster, in increasing order (the cluster rules').
+    others: Vec<u32>,
     /// Ground-area squares: (sum z, count) per square in a bounding box.
     area: Vec<(f32, u32)>,
     /// Per area square, with a border of one square around the area: the mean height of the

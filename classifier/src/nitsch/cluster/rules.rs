@@ -92,8 +92,13 @@ impl ClusterWorkspace {
         // (the same additions in the same order, without a chain through memory per point).
         let (parent, area) = (&self.parent[..], &mut self.area[..]);
         let (mut run, mut acc) = (usize::MAX, (0f32, 0u32));
+        // The members of the other clusters, for the area test below (most members are the
+        // largest cluster's: that loop then skips none).
+        self.others.clear();
         for &i in &self.members {
-            if parent[i as usize] == largest as u32 {
+            if parent[i as usize] != largest as u32 {
+                self.others.push(i);
+            } else {
                 let p = points[i as usize];
                 // The largest cluster's points lie inside its box: `p - lo >= 0`, whose truncation
                 // is its floor (one conversion, no correction; `nx`, `ny` <= 4096).
@@ -136,9 +141,9 @@ impl ClusterWorkspace {
             x1 < -1 || y1 < -1 || x0 > nx as isize || y0 > ny as isize
         };
         let (mut run, mut far, mut inside, mut height, mut outside) = (NONE, false, 0u32, 0f32, Vec3::ZERO);
-        for &i in &self.members {
+        for &i in &self.others {
             let root = self.parent[i as usize];
-            if root == largest as u32 || (self.size[root as usize] as usize) < params.min_cluster_points {
+            if (self.size[root as usize] as usize) < params.min_cluster_points {
                 continue;
             }
             if root != run {
