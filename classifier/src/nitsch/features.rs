@@ -124,7 +124,7 @@ struct Soa {
     /// below it hold returns, else 0 (0 on the first and last rows).
     column3: Vec<u8>,
     /// The tile's two square rows around the row being processed ([`squares::square_row`]), by parity.
-    squares: [Vec<squares::SquareChunk>; 2],
+    squares: [squares::SquareRow; 2],
     /// Per square row: the last square left of the tile (lane 0 of the tile's first chunk).
     edge: Vec<[f32; squares::SQUARE_FIELDS]>,
     /// Horizontal edge lengths of the row being processed, by column.
@@ -363,9 +363,6 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     let mut queue = GeneralQueue::new();
     soa.horizontal.resize(cols, 0.0);
     soa.edge.resize(rows - 1, [0.0; squares::SQUARE_FIELDS]);
-    for sq in &mut soa.squares {
-        sq.resize(TILE, [[0.0; L + 1]; squares::SQUARE_FIELDS]);
-    }
     let (horizontal, edge, ring) = (&mut soa.horizontal, &mut soa.edge, &mut soa.squares);
     let xyz = [plane.x, plane.y, plane.z];
     for t0 in (0..inner).step_by(TILE) {
@@ -376,8 +373,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
             squares::horizontal_row(xyz, r, cols, tile.start.max(1) * L - 1..tile.end * L, horizontal);
             let (below, above) = (&ring[(r - 1) % 2], &ring[r % 2]);
             for j in tile.start.max(1)..tile.end {
-                let (b, a) = (&below[j - tile.start], &above[j - tile.start]);
-                fast_block(&plane, b, a, horizontal, r, j, &mut queue, &mut outputs);
+                fast_block(&plane, below, above, horizontal, r, j, j - tile.start, &mut queue, &mut outputs);
             }
         }
     }
@@ -402,17 +398,18 @@ fn column_triples(valid: &[bool], cols: usize, out: &mut Vec<u8>) {
     }
 }
 
-/// The `L` cells of row `r` in chunk `j` (clear of the grid's edges) from the squares of the chunk
+/// The `L` cells of row `r` in chunk `j` (the tile's chunk `jj`; clear of the grid's edges) from the squares of the chunk
 /// below and above the row; cells that lack a direct neighbour go to `queue` (the general search).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn fast_block(
     plane: &Plane<'_>,
-    below: &squares::SquareChunk,
-    above: &squares::SquareChunk,
+    below: &squares::SquareRow,
+    above: &squares::SquareRow,
     horizontal: &[f32],
     r: usize,
     j: usize,
+    jj: usize,
     queue: &mut GeneralQueue,
     out: &mut Outputs<'_>,
 ) {
@@ -428,7 +425,7 @@ fn fast_block(
         out.zero(i0, L);
         return;
     }
-    let acc = squares::dense_block(plane.view.ranges, below, above, horizontal, r, j, cols, &plane.tests);
+    let acc = squares::dense_block(plane.view.ranges, below, above, horizontal, r, j, jj, cols, &plane.tests);
     let mut f = Cells::default();
     acc.finish(plane.min_pairs, &mut f);
     out.write(i0, L, &[true; L], &f);

@@ -24,7 +24,7 @@
 // Lane arrays are indexed by field and lane on purpose (vectorized across columns).
 #![allow(clippy::needless_range_loop)]
 
-use super::{Acc, L, Tests, rsqrt};
+use super::{Acc, L, TILE, Tests, rsqrt};
 
 /// Floats stored per triangle: the cross product `x, y, z`, its squared length and `1 / |n|`.
 const TRI: usize = 5;
@@ -37,13 +37,30 @@ const DIAGONAL: usize = 4 * TRI + 1;
 /// Length of the anti-diagonal edge `|u - b|`.
 const ANTI: usize = 4 * TRI + 2;
 
-/// The squares of columns `j L - 1 .. j L + L` of chunk `j`, every field as `L + 1` lanes: lane
-/// `l + 1` is column `j L + l`, and lane 0 repeats the last square of chunk `j - 1`, so that the
-/// fast path reads the squares at `c` and at `c - 1` of `L` cells as plain loads (no shuffles).
-/// (One array per chunk, not one row-long array per field: the compiler vectorizes stores into
-/// one array, while 23 separate row slices might overlap as far as it can tell, and it then
-/// writes lane by lane, 10 times slower.)
-pub(super) type SquareChunk = [[f32; L + 1]; SQUARE_FIELDS];
+/// Lanes of a [`SquareRow`] before its first chunk; the last of them holds the square left of the
+/// tile, so that chunk `jj`'s squares start at the aligned lane `LEAD + jj L`.
+const LEAD: usize = L;
+
+/// The squares of one square row over a tile's chunks, every field as a row of lanes: lane
+/// `LEAD + jj L + l` is column `j L + l` of the tile's chunk `jj` (`j` = tile start + `jj`), and lane
+/// `LEAD - 1` the square left of the tile. The fast path reads the squares at `c` and at `c - 1` of
+/// `L` cells as plain loads (no shuffles).
+///
+/// Each field's row is 64-byte aligned and a whole number of cache lines long, so the `L` lanes a
+/// chunk stores per field are one aligned store (one cache line with `L` = 16), not a store split
+/// over two lines: the layout with the left square at lane 0 of `L + 1` lanes per chunk split
+/// every store and most loads. One array for all fields, not one slice per field: the compiler
+/// vectorizes stores into one array, while 23 separate slices might overlap as far as it can tell,
+/// and it then writes lane by lane, 10 times slower.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub(super) struct SquareRow([[f32; LEAD + TILE * L]; SQUARE_FIELDS]);
+
+impl Default for SquareRow {
+    fn default() -> Self {
+        Self([[0.0; LEAD + TILE * L]; SQUARE_FIELDS])
+    }
+}
 
 /// `L` consecutive values of `a` from `i` on.
 #[inline(always)]
@@ -69,11 +86,12 @@ pub(super) fn inner_chunks(cols: usize) -> usize {
     (cols - 1) / L
 }
 
-/// Fills `out` (one per chunk of `chunks`) with the triangles and edge lengths of the squares
-/// between rows `s` and `s + 1` of the plane (the coordinates `x`, `y`, `z`, each row-major). `edge` holds the last
-/// square of the chunk before `chunks` (lane 0 of the first chunk) and gets the last square of
-/// `chunks`. Squares with a corner without a return get meaningless values; the fast path never
-/// reads them. Needs `chunks.end <= inner_chunks(cols)` and `s + 1` a row of the plane.
+/// Fills `out` with the triangles and edge lengths of the squares between rows `s` and `s + 1` of
+/// the plane (the coordinates `x`, `y`, `z`, each row-major) over the chunks `chunks` (at most
+/// [`TILE`]). `edge` holds the last square of the chunk before `chunks` (lane `LEAD - 1`) and gets
+/// the last square of `chunks`. Squares with a corner without a return get meaningless values; the
+/// fast path never reads them. Needs `chunks.end <= inner_chunks(cols)` and `s + 1` a row of the
+/// plane.
 #[inline(always)]
 pub(super) fn square_row(
     [xs, ys, zs]: [&[f32]; 3],
@@ -81,13 +99,15 @@ pub(super) fn square_row(
     cols: usize,
     chunks: std::ops::Range<usize>,
     edge: &mut [f32; SQUARE_FIELDS],
-    out: &mut [SquareChunk],
+    out: &mut SquareRow,
 ) {
-    let out = &mut out[..chunks.len()];
-    for (o, j) in out.iter_mut().zip(chunks) {
+    assert!(chunks.len() <= TILE, "a tile has at most TILE chunks");
+    let o = &mut out.0;
+    for (jj, j) in chunks.clone().enumerate() {
         let (ia, iu) = (s * cols + j * L, (s + 1) * cols + j * L);
         let load = |i: usize| [at(xs, i), at(ys, i), at(zs, i)];
         let (a, b, u, v) = (load(ia), load(ia + 1), load(iu), load(iu + 1));
+        let base = LEAD + (jj % TILE) * L;
         for l in 0..L {
             let (ua, va, ba) = (sub(&u, &a, l), sub(&v, &a, l), sub(&b, &a, l));
             let (vb, ub, ab) = (sub(&v, &b, l), sub(&u, &b, l), sub(&a, &b, l));
@@ -96,25 +116,22 @@ pub(super) fn square_row(
                 let y = p[2] * q[0] - p[0] * q[2];
                 let z = p[0] * q[1] - p[1] * q[0];
                 let nl2 = x * x + y * y + z * z;
-                o[t * TRI][l + 1] = x;
-                o[t * TRI + 1][l + 1] = y;
-                o[t * TRI + 2][l + 1] = z;
-                o[t * TRI + 3][l + 1] = nl2;
-                o[t * TRI + 4][l + 1] = rsqrt(nl2.max(f32::MIN_POSITIVE));
+                o[t * TRI][base + l] = x;
+                o[t * TRI + 1][base + l] = y;
+                o[t * TRI + 2][base + l] = z;
+                o[t * TRI + 3][base + l] = nl2;
+                o[t * TRI + 4][base + l] = rsqrt(nl2.max(f32::MIN_POSITIVE));
             }
-            o[VERTICAL][l + 1] = length(ua);
-            o[DIAGONAL][l + 1] = length(va);
-            o[ANTI][l + 1] = length(ub);
+            o[VERTICAL][base + l] = length(ua);
+            o[DIAGONAL][base + l] = length(va);
+            o[ANTI][base + l] = length(ub);
         }
     }
-    // Lane 0: the previous chunk's last square.
+    // Lane `LEAD - 1`: the previous chunk's last square; then this tile's last square for the next.
+    let last = LEAD + chunks.len() * L - 1;
     for (f, e) in edge.iter_mut().enumerate() {
-        let mut last = *e;
-        for o in out.iter_mut() {
-            o[f][0] = last;
-            last = o[f][L];
-        }
-        *e = last;
+        o[f][LEAD - 1] = *e;
+        *e = o[f][last];
     }
 }
 
@@ -148,10 +165,11 @@ const PAIR_TRIANGLE: [(bool, usize, usize); 8] = [
     (true, 3, 1),  // d8 x d7: T3 of square (r, c - 1)
 ];
 
-/// Field `f` of the `L` squares from column `j L - back` on (`back` 0 or 1).
+/// Field `f` of the `L` squares from column `j L - back` on (`back` 0 or 1), `j` the tile's chunk `jj`.
 #[inline(always)]
-fn window(chunk: &SquareChunk, f: usize, back: usize) -> [f32; L] {
-    chunk[f][1 - back..1 - back + L].try_into().expect("L lanes")
+fn window(row: &SquareRow, f: usize, jj: usize, back: usize) -> [f32; L] {
+    let start = LEAD + (jj % TILE) * L - back;
+    row.0[f][start..start + L].try_into().expect("L lanes")
 }
 
 /// Accumulates Eq. 2 and the sum of unit pair normals for the `L` cells from `(r, c0)` on
@@ -163,25 +181,26 @@ fn window(chunk: &SquareChunk, f: usize, back: usize) -> [f32; L] {
 #[inline(always)]
 pub(super) fn dense_block(
     ranges: &[f32],
-    below: &SquareChunk,
-    above: &SquareChunk,
+    below: &SquareRow,
+    above: &SquareRow,
     horizontal: &[f32],
     r: usize,
     j: usize,
+    jj: usize,
     cols: usize,
     tests: &Tests,
 ) -> Acc {
     let c0 = j * L;
     // |d_k| for d1..d8, from the squares and row edges that hold them.
     let len = [
-        window(above, VERTICAL, 0),
-        window(above, DIAGONAL, 0),
+        window(above, VERTICAL, jj, 0),
+        window(above, DIAGONAL, jj, 0),
         at(horizontal, c0),
-        window(below, ANTI, 0),
-        window(below, VERTICAL, 0),
-        window(below, DIAGONAL, 1),
+        window(below, ANTI, jj, 0),
+        window(below, VERTICAL, jj, 0),
+        window(below, DIAGONAL, jj, 1),
         at(horizontal, c0 - 1),
-        window(above, ANTI, 1),
+        window(above, ANTI, jj, 1),
     ];
     let i0 = r * cols + c0;
     let pr = at(ranges, i0);
@@ -194,22 +213,22 @@ pub(super) fn dense_block(
     }
     let mut acc = Acc::default();
     // Half the lanes at a time: the half's sums stay in registers over the 8 pairs.
-    pair::<0, 0>(below, above, &len, &ok, &mut acc);
-    pair::<1, 0>(below, above, &len, &ok, &mut acc);
-    pair::<2, 0>(below, above, &len, &ok, &mut acc);
-    pair::<3, 0>(below, above, &len, &ok, &mut acc);
-    pair::<4, 0>(below, above, &len, &ok, &mut acc);
-    pair::<5, 0>(below, above, &len, &ok, &mut acc);
-    pair::<6, 0>(below, above, &len, &ok, &mut acc);
-    pair::<7, 0>(below, above, &len, &ok, &mut acc);
-    pair::<0, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<1, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<2, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<3, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<4, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<5, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<6, { L / 2 }>(below, above, &len, &ok, &mut acc);
-    pair::<7, { L / 2 }>(below, above, &len, &ok, &mut acc);
+    pair::<0, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<1, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<2, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<3, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<4, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<5, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<6, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<7, 0>(below, above, jj, &len, &ok, &mut acc);
+    pair::<0, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<1, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<2, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<3, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<4, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<5, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<6, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    pair::<7, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
     acc
 }
 
@@ -217,15 +236,16 @@ pub(super) fn dense_block(
 /// are constant offsets).
 #[inline(always)]
 fn pair<const K: usize, const H: usize>(
-    below: &SquareChunk,
-    above: &SquareChunk,
+    below: &SquareRow,
+    above: &SquareRow,
+    jj: usize,
     len: &[[f32; L]; 8],
     ok: &[[f32; L]; 8],
     acc: &mut Acc,
 ) {
     let (up, t, back) = PAIR_TRIANGLE[K];
     let chunk = if up { above } else { below };
-    let field = |f: usize| window(chunk, f, back);
+    let field = |f: usize| window(chunk, f, jj, back);
     let (x, y, z) = (field(t * TRI), field(t * TRI + 1), field(t * TRI + 2));
     let (nl2, inv) = (field(t * TRI + 3), field(t * TRI + 4));
     let p = (K + 7) % 8;
