@@ -15,6 +15,7 @@
 //! cells without a return are never ground.
 
 pub mod baselines;
+mod cpu;
 pub mod error;
 pub mod mcdaniel;
 pub mod methods;

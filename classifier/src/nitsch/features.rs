@@ -198,8 +198,8 @@ impl Tests {
 /// (plain IEEE operations, no fused multiply-add).
 pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f") {
-        // SAFETY: the CPU supports AVX-512F (checked just above).
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
         #[allow(unsafe_code)]
         unsafe {
             return compute_features_avx512(view, params, out);
@@ -224,9 +224,9 @@ fn compute_features_avx2(view: &GridView<'_>, params: &FeatureParams, out: &mut 
     compute_features_body(view, params, out);
 }
 
-/// [`compute_features_body`] compiled for AVX-512F (16 lanes per instruction; same operations).
+/// [`compute_features_body`] compiled for AVX-512 (16 lanes per instruction; same operations).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
 fn compute_features_avx512(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     compute_features_body(view, params, out);
 }

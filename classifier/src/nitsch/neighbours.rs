@@ -190,6 +190,14 @@ pub const WRAP_ROWS: usize = 32;
 /// when a column has no return to judge from.
 pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
     #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return detect_wrap_avx512(points, rows, cols);
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
         #[allow(unsafe_code)]
@@ -204,6 +212,13 @@ pub fn detect_wrap(points: &[Vec3], rows: usize, cols: usize) -> bool {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn detect_wrap_avx2(points: &[Vec3], rows: usize, cols: usize) -> bool {
+    detect_wrap_body(points, rows, cols)
+}
+
+/// [`detect_wrap_body`] compiled for AVX-512 ([`crate::cpu::avx512`]) (plain IEEE operations: the same result).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+fn detect_wrap_avx512(points: &[Vec3], rows: usize, cols: usize) -> bool {
     detect_wrap_body(points, rows, cols)
 }
 

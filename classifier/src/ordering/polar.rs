@@ -28,6 +28,14 @@ pub(crate) fn polar<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> Polar
 /// (0, 0, 0), as [`super::usable`] counts them.
 pub(crate) fn polar_counting<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (usize, usize)) {
     #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return polar_avx512(points, valid);
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
         #[allow(unsafe_code)]
@@ -42,6 +50,13 @@ pub(crate) fn polar_counting<P: InputPoint>(points: &[P], valid: Option<&[u32]>)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn polar_avx2<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (usize, usize)) {
+    polar_body(points, valid)
+}
+
+/// [`polar_body`] compiled for AVX-512 ([`crate::cpu::avx512`]) (plain IEEE operations only: the same bits as without it).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+fn polar_avx512<P: InputPoint>(points: &[P], valid: Option<&[u32]>) -> (Polar, (usize, usize)) {
     polar_body(points, valid)
 }
 

@@ -100,6 +100,14 @@ pub(crate) fn bad_and_no_return(x: f32, y: f32, z: f32) -> (bool, bool) {
 /// where the CPU has it: the same counts, about half the instructions of the baseline build).
 fn count_bad_and_zero<P: InputPoint>(points: &[P]) -> (usize, usize) {
     #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return count_avx512(points);
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
         #[allow(unsafe_code)]
@@ -114,6 +122,13 @@ fn count_bad_and_zero<P: InputPoint>(points: &[P]) -> (usize, usize) {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn count_avx2<P: InputPoint>(points: &[P]) -> (usize, usize) {
+    count_body(points)
+}
+
+/// [`count_body`] compiled for AVX-512 ([`crate::cpu::avx512`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+fn count_avx512<P: InputPoint>(points: &[P]) -> (usize, usize) {
     count_body(points)
 }
 

@@ -4,8 +4,6 @@
 
 use glam::Vec3;
 
-#[cfg(target_arch = "x86_64")]
-use super::avx2_bmi;
 use super::{ClusterParams, ClusterWorkspace, NONE};
 
 /// A count of [`ClusterWorkspace`]'s `near` squares not computed yet.
@@ -42,12 +40,20 @@ pub(super) fn floor_isize(v: f32) -> isize {
 impl ClusterWorkspace {
     /// Applies the cluster rules (module docs) and writes the ground decision of every cell of the
     /// plane into `ground` (non-candidates false). `points` are the points of the last
-    /// [`cluster_candidates`] (whose pass also found each cluster's bounding box) and `returns` the
-    /// number of returns of the plane. (Compiled for AVX2 and BMI where the CPU has them, as
-    /// [`cluster_candidates_with`].)
+    /// [`super::cluster_candidates`] (whose pass also found each cluster's bounding box) and `returns` the
+    /// number of returns of the plane. (Compiled for AVX-512 or AVX2 and BMI where the CPU has them, as
+    /// [`super::cluster_candidates_with`].)
     pub fn decide(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
         #[cfg(target_arch = "x86_64")]
-        if avx2_bmi() {
+        if crate::cpu::avx512() {
+            // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.decide_avx512(points, returns, params, ground);
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if crate::cpu::avx2_bmi() {
             // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
             #[allow(unsafe_code)]
             unsafe {
@@ -61,6 +67,13 @@ impl ClusterWorkspace {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2")]
     fn decide_avx2(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
+        self.decide_body(points, returns, params, ground);
+    }
+
+    /// [`ClusterWorkspace::decide_body`] compiled for AVX-512 ([`crate::cpu::avx512`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+    fn decide_avx512(&mut self, points: &[Vec3], returns: usize, params: &ClusterParams, ground: &mut [bool]) {
         self.decide_body(points, returns, params, ground);
     }
 

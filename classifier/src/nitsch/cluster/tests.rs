@@ -123,7 +123,7 @@ fn grid_order_clustering_equals_the_per_cell_definition() {
             }
             assert_eq!(fast.cluster_count(), ws.cluster_count());
             clusters_seen += ws.cluster_count();
-            // The portable variant too (the dispatcher above may have picked AVX2), and the
+            // The portable variant too (the dispatcher above may have picked AVX-512 or AVX2), and the
             // rules of both.
             let mut portable = ClusterWorkspace::default();
             let inputs = Inputs {
@@ -135,6 +135,17 @@ fn grid_order_clustering_equals_the_per_cell_definition() {
             };
             cluster_body(inputs, &params.clustering, &mut portable);
             assert_eq!(portable.parent, fast.parent);
+            // And the AVX2 variant where the dispatcher picked AVX-512.
+            #[cfg(target_arch = "x86_64")]
+            if crate::cpu::avx2_bmi() {
+                let mut avx2 = ClusterWorkspace::default();
+                // SAFETY: the CPU supports AVX2, BMI1 and BMI2 (checked just above).
+                #[allow(unsafe_code)]
+                unsafe {
+                    super::cluster_avx2(inputs, &params.clustering, &mut avx2)
+                };
+                assert_eq!(avx2.parent, fast.parent);
+            }
             // With the features' own search tables, as the classifier runs it.
             let mut searched = ClusterWorkspace::default();
             let (valid, search) = (nitsch.features.valid(), nitsch.features.search());

@@ -167,12 +167,26 @@ fn lane_wise_features_equal_the_per_cell_definition() {
             let view = classifier.view(&cloud);
             let (mut fast, mut generic) = (Features::default(), Features::default());
             compute_features(&view, &params, &mut fast);
-            // The portable variant too (the dispatcher above may have picked AVX2).
+            // The portable variant too (the dispatcher above may have picked AVX-512 or AVX2).
             compute_features_body(&view, &params, &mut generic);
             assert_eq!(
                 fast.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>(),
                 generic.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>()
             );
+            // And the AVX2 variant where the dispatcher picked AVX-512.
+            #[cfg(target_arch = "x86_64")]
+            if crate::cpu::avx2_bmi() {
+                let mut avx2 = Features::default();
+                // SAFETY: the CPU supports AVX2 (checked just above).
+                #[allow(unsafe_code)]
+                unsafe {
+                    super::compute_features_avx2(&view, &params, &mut avx2)
+                };
+                assert_eq!(
+                    avx2.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>(),
+                    generic.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>()
+                );
+            }
             let want = reference(&view, &params);
             for (i, &(n, n_rho, g_rho)) in want.iter().enumerate() {
                 let got = (fast.normal[i], fast.n_rho[i], fast.g_rho[i]);

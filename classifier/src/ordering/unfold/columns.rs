@@ -93,6 +93,14 @@ pub(crate) fn ring_columns(
     out: &mut [u32],
 ) -> bool {
     #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return ring_columns_avx512(rows, row, az, dist, dir, scratch, out);
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
         #[allow(unsafe_code)]
@@ -107,6 +115,21 @@ pub(crate) fn ring_columns(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn ring_columns_avx2(
+    rows: &TableRows,
+    row: usize,
+    az: &[f32],
+    dist: &[f32],
+    dir: f32,
+    scratch: &mut ColumnScratch,
+    out: &mut [u32],
+) -> bool {
+    ring_columns_body(rows, row, az, dist, dir, scratch, out)
+}
+
+/// [`ring_columns_body`] compiled for AVX-512 ([`crate::cpu::avx512`]) (plain IEEE operations: the same columns).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+fn ring_columns_avx512(
     rows: &TableRows,
     row: usize,
     az: &[f32],

@@ -128,6 +128,14 @@ pub(crate) fn ring_starts(
     params: &UnfoldParams,
 ) -> Result<(Vec<usize>, f32), String> {
     #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx512() {
+        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
+        #[allow(unsafe_code)]
+        unsafe {
+            return ring_starts_avx512(az, dist, fine, rows, params);
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
         #[allow(unsafe_code)]
@@ -142,6 +150,19 @@ pub(crate) fn ring_starts(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn ring_starts_avx2(
+    az: &[f32],
+    dist: &[f32],
+    fine: &[f32],
+    rows: &TableRows,
+    params: &UnfoldParams,
+) -> Result<(Vec<usize>, f32), String> {
+    ring_starts_body(az, dist, fine, rows, params)
+}
+
+/// [`ring_starts_body`] compiled for AVX-512 ([`crate::cpu::avx512`]) (plain IEEE operations: the same rings).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
+fn ring_starts_avx512(
     az: &[f32],
     dist: &[f32],
     fine: &[f32],
