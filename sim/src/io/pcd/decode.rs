@@ -101,6 +101,9 @@ impl Decoder {
     /// field's type decided once: a per-point dispatch over every field cost 3 ms of a 128 x 1024
     /// ouster-ros frame, and whole-file loops per field streamed the records from memory once per
     /// field.
+    ///
+    /// Compiled for AVX-512 or AVX2 where the CPU has them (the field loops run as wide as the CPU
+    /// allows; plain conversions and IEEE operations, so the same values in every variant).
     pub(super) fn decode(
         &mut self,
         src: &Source<'_>,
@@ -108,6 +111,47 @@ impl Decoder {
         out_start: usize,
         cloud: &mut OrderedCloud,
     ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx2")
+        {
+            // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ and AVX2 (checked just above).
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.decode_avx512(src, points, out_start, cloud);
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.decode_avx2(src, points, out_start, cloud);
+            }
+        }
+        self.decode_body(src, points, out_start, cloud);
+    }
+
+    /// [`Decoder::decode_body`] compiled for AVX-512 (F, BW, VL, DQ) and AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2")]
+    fn decode_avx512(&mut self, src: &Source<'_>, points: Range<usize>, out_start: usize, cloud: &mut OrderedCloud) {
+        self.decode_body(src, points, out_start, cloud);
+    }
+
+    /// [`Decoder::decode_body`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn decode_avx2(&mut self, src: &Source<'_>, points: Range<usize>, out_start: usize, cloud: &mut OrderedCloud) {
+        self.decode_body(src, points, out_start, cloud);
+    }
+
+    /// The body of [`Decoder::decode`], inlined into each instruction-set variant.
+    #[inline(always)]
+    fn decode_body(&mut self, src: &Source<'_>, points: Range<usize>, out_start: usize, cloud: &mut OrderedCloud) {
         let OrderedCloud {
             point_in_vehicle,
             range_m,
