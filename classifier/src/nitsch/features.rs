@@ -213,7 +213,7 @@ pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut F
             return compute_features_avx2(view, params, out);
         }
     }
-    compute_features_body(view, params, out);
+    compute_features_body::<false>(view, params, out);
 }
 
 /// [`compute_features_body`] compiled for AVX2 (8 lanes per instruction). Only plain IEEE
@@ -221,14 +221,15 @@ pub fn compute_features(view: &GridView<'_>, params: &FeatureParams, out: &mut F
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn compute_features_avx2(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
-    compute_features_body(view, params, out);
+    compute_features_body::<false>(view, params, out);
 }
 
-/// [`compute_features_body`] compiled for AVX-512 (16 lanes per instruction; same operations).
+/// [`compute_features_body`] compiled for AVX-512 (16 lanes per instruction; same operations),
+/// with the pair sums of all 16 lanes at once (`WIDE`): AVX-512's 32 registers hold them.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
 fn compute_features_avx512(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
-    compute_features_body(view, params, out);
+    compute_features_body::<true>(view, params, out);
 }
 
 /// Square chunks per tile of the fast path: the tile's two square rows (about 25 kB) stay in the
@@ -302,7 +303,7 @@ impl Outputs<'_> {
 /// tiles of [`TILE`] blocks going up the rows; the others (first and last rows and blocks, grids
 /// too small) take the general search.
 #[inline(always)]
-fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
+fn compute_features_body<const WIDE: bool>(view: &GridView<'_>, params: &FeatureParams, out: &mut Features) {
     let (rows, cols) = (view.rows, view.cols);
     let n = rows * cols;
     out.resize(n);
@@ -373,7 +374,7 @@ fn compute_features_body(view: &GridView<'_>, params: &FeatureParams, out: &mut 
             squares::horizontal_row(xyz, r, cols, tile.start.max(1) * L - 1..tile.end * L, horizontal);
             let (below, above) = (&ring[(r - 1) % 2], &ring[r % 2]);
             for j in tile.start.max(1)..tile.end {
-                fast_block(&plane, below, above, horizontal, r, j, j - tile.start, &mut queue, &mut outputs);
+                fast_block::<WIDE>(&plane, below, above, horizontal, r, j, j - tile.start, &mut queue, &mut outputs);
             }
         }
     }
@@ -402,7 +403,7 @@ fn column_triples(valid: &[bool], cols: usize, out: &mut Vec<u8>) {
 /// below and above the row; cells that lack a direct neighbour go to `queue` (the general search).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn fast_block(
+fn fast_block<const WIDE: bool>(
     plane: &Plane<'_>,
     below: &squares::SquareRow,
     above: &squares::SquareRow,
@@ -425,7 +426,7 @@ fn fast_block(
         out.zero(i0, L);
         return;
     }
-    let acc = squares::dense_block(plane.view.ranges, below, above, horizontal, r, j, jj, cols, &plane.tests);
+    let acc = squares::dense_block::<WIDE>(plane.view.ranges, below, above, horizontal, r, j, jj, cols, &plane.tests);
     let mut f = Cells::default();
     acc.finish(plane.min_pairs, &mut f);
     out.write(i0, L, &[true; L], &f);

@@ -179,7 +179,7 @@ fn window(row: &SquareRow, f: usize, jj: usize, back: usize) -> [f32; L] {
 /// The same operations per pair as [`super::lane_features`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub(super) fn dense_block(
+pub(super) fn dense_block<const WIDE: bool>(
     ranges: &[f32],
     below: &SquareRow,
     above: &SquareRow,
@@ -212,30 +212,44 @@ pub(super) fn dense_block(
         }
     }
     let mut acc = Acc::default();
-    // Half the lanes at a time: the half's sums stay in registers over the 8 pairs.
-    pair::<0, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<1, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<2, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<3, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<4, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<5, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<6, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<7, 0>(below, above, jj, &len, &ok, &mut acc);
-    pair::<0, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<1, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<2, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<3, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<4, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<5, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<6, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-    pair::<7, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+    if WIDE {
+        // All lanes at once (AVX-512: the 7 sums of 16 lanes stay in 7 of its 32 registers).
+        pair::<0, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<1, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<2, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<3, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<4, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<5, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<6, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        pair::<7, 0, L>(below, above, jj, &len, &ok, &mut acc);
+        return acc;
+    }
+    // Half the lanes at a time: the half's sums stay in registers over the 8 pairs (AVX2's 16
+    // registers do not hold the sums of all 16 lanes).
+    const H: usize = L / 2;
+    pair::<0, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<1, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<2, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<3, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<4, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<5, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<6, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<7, 0, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<0, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<1, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<2, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<3, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<4, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<5, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<6, H, H>(below, above, jj, &len, &ok, &mut acc);
+    pair::<7, H, H>(below, above, jj, &len, &ok, &mut acc);
     acc
 }
 
-/// Pair `K` of [`dense_block`] for the lanes `H .. H + L / 2` (constants, so the triangle's fields
+/// Pair `K` of [`dense_block`] for the lanes `H .. H + W` (constants, so the triangle's fields
 /// are constant offsets).
 #[inline(always)]
-fn pair<const K: usize, const H: usize>(
+fn pair<const K: usize, const H: usize, const W: usize>(
     below: &SquareRow,
     above: &SquareRow,
     jj: usize,
@@ -249,7 +263,7 @@ fn pair<const K: usize, const H: usize>(
     let (x, y, z) = (field(t * TRI), field(t * TRI + 1), field(t * TRI + 2));
     let (nl2, inv) = (field(t * TRI + 3), field(t * TRI + 4));
     let p = (K + 7) % 8;
-    for l in H..H + L / 2 {
+    for l in H..H + W {
         let (lk, lp) = (len[K][l], len[p][l]);
         let tt = lk * lp;
         let valid = if nl2[l] > 1e-24 * tt * tt { ok[K][l] * ok[p][l] } else { 0.0 };

@@ -168,11 +168,19 @@ fn lane_wise_features_equal_the_per_cell_definition() {
             let (mut fast, mut generic) = (Features::default(), Features::default());
             compute_features(&view, &params, &mut fast);
             // The portable variant too (the dispatcher above may have picked AVX-512 or AVX2).
-            compute_features_body(&view, &params, &mut generic);
+            compute_features_body::<false>(&view, &params, &mut generic);
             assert_eq!(
                 fast.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>(),
                 generic.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>()
             );
+            // The pair sums of all 16 lanes at once (the AVX-512 variant's) and by halves: the same bits.
+            let mut wide = Features::default();
+            compute_features_body::<true>(&view, &params, &mut wide);
+            assert_eq!(
+                wide.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>(),
+                generic.g_rho.iter().map(|g| g.to_bits()).collect::<Vec<_>>()
+            );
+            assert_eq!(wide.normal, generic.normal);
             // And the AVX2 variant where the dispatcher picked AVX-512.
             #[cfg(target_arch = "x86_64")]
             if crate::cpu::avx2_bmi() {
