@@ -66,6 +66,7 @@ use glam::Vec3;
 use crate::error::{ClassifyError, Result};
 use crate::nitsch::neighbours::GridView;
 use crate::nitsch::row_returns::RowReturns;
+use box_xy::BoxXy;
 
 /// Parameters of clustering and of the cluster rules.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -484,7 +485,7 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
     ws.bbox.resize(n, (glam::Vec2::ZERO, glam::Vec2::ZERO));
     // Consecutive members mostly share a root: its size and box stay in registers for the run
     // (no read-modify-write chain through memory per cell), and are stored when the root changes.
-    let (mut run, mut count, mut lo, mut hi) = (NONE, 0u32, glam::Vec2::ZERO, glam::Vec2::ZERO);
+    let (mut run, mut count, mut bounds) = (NONE, 0u32, BoxXy::new(glam::Vec2::ZERO));
     for &i in &ws.members {
         let i = i as usize;
         let p = parent[i];
@@ -496,21 +497,22 @@ fn cluster_body(inputs: Inputs<'_>, params: &ClusterParams, ws: &mut ClusterWork
         let xy = points[i].truncate();
         if root != run {
             if run != NONE {
-                (ws.size[run as usize], ws.bbox[run as usize]) = (count, (lo, hi));
+                (ws.size[run as usize], ws.bbox[run as usize]) = (count, bounds.corners());
             }
             run = root;
             if root == i as u32 {
                 ws.roots.push(root);
-                (count, lo, hi) = (0, xy, xy);
+                (count, bounds) = (0, BoxXy::new(xy));
             } else {
-                (count, (lo, hi)) = (ws.size[root as usize], ws.bbox[root as usize]);
+                (count, bounds) = (ws.size[root as usize], BoxXy::from_corners(ws.bbox[root as usize]));
             }
         }
         count += 1;
-        (lo, hi) = (lo.min(xy), hi.max(xy));
+        // Two independent `minps` / `maxps` chains ([`box_xy`]).
+        bounds.grow(xy);
     }
     if run != NONE {
-        (ws.size[run as usize], ws.bbox[run as usize]) = (count, (lo, hi));
+        (ws.size[run as usize], ws.bbox[run as usize]) = (count, bounds.corners());
     }
 }
 
@@ -551,6 +553,7 @@ impl ClusterWorkspace {
     }
 }
 
+mod box_xy;
 mod rules;
 #[cfg(test)]
 mod tests;
