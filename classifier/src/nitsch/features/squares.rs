@@ -214,36 +214,34 @@ pub(super) fn dense_block<const WIDE: bool>(
     let mut acc = Acc::default();
     if WIDE {
         // All lanes at once (AVX-512: the 7 sums of 16 lanes stay in 7 of its 32 registers).
-        pair::<0, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<1, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<2, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<3, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<4, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<5, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<6, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        pair::<7, 0, L>(below, above, jj, &len, &ok, &mut acc);
-        return acc;
+        pairs::<0, L>(below, above, jj, &len, &ok, &mut acc);
+    } else {
+        // Half the lanes at a time: the half's sums stay in registers over the 8 pairs (AVX2's 16
+        // registers do not hold the sums of all 16 lanes).
+        pairs::<0, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+        pairs::<{ L / 2 }, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
     }
-    // Half the lanes at a time: the half's sums stay in registers over the 8 pairs (AVX2's 16
-    // registers do not hold the sums of all 16 lanes).
-    const H: usize = L / 2;
-    pair::<0, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<1, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<2, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<3, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<4, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<5, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<6, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<7, 0, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<0, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<1, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<2, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<3, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<4, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<5, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<6, H, H>(below, above, jj, &len, &ok, &mut acc);
-    pair::<7, H, H>(below, above, jj, &len, &ok, &mut acc);
     acc
+}
+
+/// The 8 pairs of [`dense_block`], in order, for the lanes `H .. H + W`.
+#[inline(always)]
+fn pairs<const H: usize, const W: usize>(
+    below: &SquareRow,
+    above: &SquareRow,
+    jj: usize,
+    len: &[[f32; L]; 8],
+    ok: &[[f32; L]; 8],
+    acc: &mut Acc,
+) {
+    pair::<0, H, W>(below, above, jj, len, ok, acc);
+    pair::<1, H, W>(below, above, jj, len, ok, acc);
+    pair::<2, H, W>(below, above, jj, len, ok, acc);
+    pair::<3, H, W>(below, above, jj, len, ok, acc);
+    pair::<4, H, W>(below, above, jj, len, ok, acc);
+    pair::<5, H, W>(below, above, jj, len, ok, acc);
+    pair::<6, H, W>(below, above, jj, len, ok, acc);
+    pair::<7, H, W>(below, above, jj, len, ok, acc);
 }
 
 /// Pair `K` of [`dense_block`] for the lanes `H .. H + W` (constants, so the triangle's fields
