@@ -1,6 +1,6 @@
 //! Criterion benchmark: features plus clustering of one synthetic 128 x 2048 frame on one core
 //! (target: at most 5 ms in release), and the stages separately. Pin it to one core:
-//! `taskset -c 0 cargo bench -p classifier`.
+//! `taskset -c 0 cargo bench -p groundtruth-classifier`.
 
 use classifier::nitsch::cluster::{ClusterWorkspace, cluster_candidates};
 use classifier::nitsch::features::{Features, compute_features};

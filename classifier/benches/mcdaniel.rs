@@ -1,7 +1,7 @@
 //! Criterion benchmark of McDaniel et al. on one 200 x 1081 sweep (`utm30lx-nodding` on
 //! `forest-dense`, scene and scan seed 0): the whole frame (origins, stage 1, f1-f8, SVM,
 //! propagation) with the bundled model, and the ray-tracing feature f8 alone.
-//! `cargo bench -p classifier --bench mcdaniel`.
+//! `cargo bench -p groundtruth-classifier --bench mcdaniel`.
 
 use classifier::mcdaniel::{self, Columns, FeatureParams, McDaniel, McDanielParams};
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -1,7 +1,7 @@
 //! Times the Nitsch method (features, clustering, cluster rules, echo planes) on the synthetic
 //! 128 x 2048 frame: the thread's own CPU time per frame (`/proc/thread-self/schedstat`, Linux,
 //! averaged over all repetitions), which stays meaningful on a loaded machine, and the wall time
-//! per stage (min and median). Pin it to one core: `taskset -c 0`. Run with `cargo run --release -p classifier --example bench_cpu`.
+//! per stage (min and median). Pin it to one core: `taskset -c 0`. Run with `cargo run --release -p groundtruth-classifier --example bench_cpu`.
 
 use classifier::synthetic::benchmark_frame;
 use classifier::{Nitsch, NitschParams};

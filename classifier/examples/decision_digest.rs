@@ -1,7 +1,7 @@
 //! Prints a digest (FNV-1a over the exact bits) of the features, cluster roots and decisions of the
 //! Nitsch method on synthetic frames with dropouts and noise, under several parameter sets. Run it
 //! before and after a performance change: identical lines mean identical outputs.
-//! `cargo run --release -p classifier --example decision_digest`
+//! `cargo run --release -p groundtruth-classifier --example decision_digest`
 
 use classifier::nitsch::neighbours::Wrap;
 use classifier::synthetic::{SyntheticSensor, benchmark_frame, car, flat_ground};

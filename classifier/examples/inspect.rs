@@ -1,5 +1,5 @@
 //! Prints, per grid row of plane 0 of a PCD, returns, ground truth and misses of `nitsch`
-//! (a diagnostic: `cargo run --release -p classifier --example inspect -- FILE.pcd`).
+//! (a diagnostic: `cargo run --release -p groundtruth-classifier --example inspect -- FILE.pcd`).
 
 #![allow(clippy::needless_range_loop)]
 

@@ -3,7 +3,7 @@
 //! and optionally the default model trained on all three.
 //!
 //! ```sh
-//! cargo run --release -p classifier --example mcdaniel_forests [-- --write-model classifier/models/mcdaniel-forest.json]
+//! cargo run --release -p groundtruth-classifier --example mcdaniel_forests [-- --write-model classifier/models/mcdaniel-forest.json]
 //!     [--note TEXT] [--heights] [--debug] [--max-iter N] [--eps X] [--pyramid LAYERS] [--drop K]
 //! ```
 //!
@@ -155,7 +155,7 @@ fn main() {
             "measurement": "default effects (not ideal)",
             "svm": format!("dual coordinate descent, L1-loss (hinge), C = 100, eps {eps}, at most {max_iter} passes, bias as feature 1, seed 0"),
             "note": args.iter().position(|a| a == "--note").and_then(|i| args.get(i + 1)),
-            "by": "cargo run --release -p classifier --example mcdaniel_forests -- --write-model classifier/models/mcdaniel-forest.json",
+            "by": "cargo run --release -p groundtruth-classifier --example mcdaniel_forests -- --write-model classifier/models/mcdaniel-forest.json",
         });
         model.save(std::path::Path::new(&path)).expect("save");
         println!("wrote {path}");

@@ -1,5 +1,5 @@
 //! Generation time of every bundled scene (target: under 1 s each in release), with its triangle
-//! count printed once. Run: `cargo bench -p scenes --bench generate`.
+//! count printed once. Run: `cargo bench -p groundtruth-scenes --bench generate`.
 
 use std::hint::black_box;
 use std::time::Duration;

@@ -1,7 +1,7 @@
 //! Ray casting speed on the 1.3 M-triangle fixture terrain with one 128 x 2048 spinning-LiDAR frame
 //! (262,144 rays): the BVH backend (the 4-wide tree with fan traversal, one ray at a time with and
 //! without the previous-hit seed, obvhs's own BVH2 and CWBVH traversals; 1 and 2 threads) and the
-//! parry reference. `cargo bench -p sim --bench raycast`.
+//! parry reference. `cargo bench -p groundtruth-sim --bench raycast`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sim::cast::{BvhCaster, BvhLayout, BvhOptions, Caster, ParryCaster, fixture};
