@@ -16,6 +16,7 @@
 
 pub mod baselines;
 mod cpu;
+pub mod dataset;
 pub mod error;
 pub mod mcdaniel;
 pub mod methods;

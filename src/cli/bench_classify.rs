@@ -89,7 +89,7 @@ fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
     } else {
         Some(args.rig.as_str())
     };
-    let setup = super::classify::SensorSetup::new(rig, args.calibration.as_deref())?;
+    let setup = super::classify::sensor_setup(rig, args.calibration.as_deref())?;
     let repeats = args.repeats.max(1);
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());

@@ -29,8 +29,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use classifier::FrameInput;
 use classifier::ordering::{
-    BeamTable, Calibration, CloudBuffer, OrderingReport, PathChoice, PointAttributes, UnfoldParams,
-    decisions_per_point, order_cloud_into, read_organized_into,
+    CloudBuffer, OrderingReport, PointAttributes, SensorSetup, decisions_per_point, read_organized_into,
 };
 use glam::{Affine3A, Mat4};
 use sim::OrderedCloud;
@@ -113,77 +112,14 @@ fn list_inputs(input: &Path) -> anyhow::Result<Vec<InputFrame>> {
         .collect())
 }
 
-/// Columns of the default KITTI beam table: real HDL-64E frames in KITTI hold up to about 2,160
-/// points per laser (the head turns a little slower than 10 Hz), more than the 2,083 of an exact
-/// 10 Hz turn, so 2,083 columns would make every ring share cells.
-const KITTI_COLUMNS: usize = 2170;
-
-/// What orders files from other tools: the beam table and the mount taking sensor-frame points to
-/// the vehicle frame.
-#[derive(Clone, Debug)]
-pub(crate) struct SensorSetup {
-    /// The beam table.
-    pub table: BeamTable,
-    /// Mount (identity without a rig).
-    pub vehicle_from_sensor: Affine3A,
-    /// Lasers of a calibration file, checked against organized clouds' rows.
-    pub calibrated_lasers: Option<usize>,
-}
-
-impl SensorSetup {
-    /// From `--rig` (a single-sensor rig: its table with origin offsets and its mount) and
-    /// `--calibration` (the unit's own angles, replacing the rig's or the default table's; the
-    /// columns from the file, else the rig, else [`KITTI_COLUMNS`]). Neither: the HDL-64E nominal
-    /// table with [`KITTI_COLUMNS`] columns, no mount.
-    pub fn new(rig: Option<&str>, calibration: Option<&Path>) -> anyhow::Result<Self> {
-        let (mut table, vehicle_from_sensor) = match rig {
-            Some(name) => {
-                let rig = super::common::load_rig(name)?;
-                if rig.sensors.len() != 1 {
-                    bail!(
-                        "rig `{name}` has {} sensors; ordering a file from another tool needs a single-sensor rig",
-                        rig.sensors.len()
-                    );
-                }
-                let s = &rig.sensors[0];
-                let table = BeamTable::from_pattern(&s.spec.pattern()).with_context(|| format!("rig `{name}`"))?;
-                // KITTI files and the drivers' clouds of a single-sensor rig hold sensor-frame points.
-                (table, s.mount.vehicle_from_sensor())
-            }
-            None => (BeamTable::hdl64e(KITTI_COLUMNS), Affine3A::IDENTITY),
-        };
-        let mut calibrated_lasers = None;
-        if let Some(file) = calibration {
-            let expected = rig.map(|_| table.elevations_rad.len());
-            let cal = Calibration::load(file, expected)?;
-            let cols = cal.columns.unwrap_or(if rig.is_some() { table.cols } else { KITTI_COLUMNS });
-            calibrated_lasers = Some(cal.lasers.len());
-            table = cal.to_table(cols);
-        }
-        Ok(Self { table, vehicle_from_sensor, calibrated_lasers })
-    }
-
-    /// Orders a flat cloud (KITTI `.bin`, unorganized PCD, PLY) into `cloud` and `report`.
-    fn order_flat<P: classifier::ordering::InputPoint>(
-        &self,
-        path: &Path,
-        points: &[P],
-        attributes: &PointAttributes<'_>,
-        cloud: &mut CloudBuffer,
-        report: &mut OrderingReport,
-    ) -> anyhow::Result<()> {
-        order_cloud_into(
-            points,
-            attributes,
-            &self.table,
-            self.vehicle_from_sensor,
-            PathChoice::Auto,
-            &UnfoldParams::default(),
-            cloud,
-            report,
-        )
-        .with_context(|| format!("ordering `{}`", path.display()))
-    }
+/// The sensor setup that orders files from other tools (`--rig`, `--calibration`; see
+/// [`classifier::ordering::SensorSetup`]), the rig given by name or file.
+pub(crate) fn sensor_setup(rig: Option<&str>, calibration: Option<&Path>) -> anyhow::Result<SensorSetup> {
+    let rig_value = rig.map(super::common::load_rig).transpose()?;
+    SensorSetup::new(rig_value.as_ref(), calibration).with_context(|| match rig {
+        Some(name) => format!("rig `{name}`"),
+        None => "the sensor setup".to_string(),
+    })
 }
 
 /// Reads and orders frames one after another, keeping its buffers (the file's bytes, its points,
@@ -256,7 +192,9 @@ impl FrameReader {
                 let rings = info.has_ring.then_some(c.ring.as_slice());
                 let attributes =
                     PointAttributes { intensity: Some(&c.intensity), labels, time_s: Some(&c.time_s), rings };
-                setup.order_flat(path, &c.point_in_vehicle, &attributes, &mut self.cloud, &mut self.report)?;
+                setup
+                    .order_flat(&c.point_in_vehicle, &attributes, &mut self.cloud, &mut self.report)
+                    .with_context(|| format!("ordering `{}`", path.display()))?;
                 self.ordered = true;
                 Ok(read_ms)
             }
@@ -273,18 +211,16 @@ impl FrameReader {
                 let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                 let flat = &self.flat;
                 let labels = flat.labels.as_deref();
-                match records {
-                    Some(records) => {
-                        // Intensities from the records themselves.
-                        let attributes = PointAttributes { labels, ..PointAttributes::default() };
-                        setup.order_flat(path, records, &attributes, &mut self.cloud, &mut self.report)?;
-                    }
+                let ordered = match records {
+                    // Scan-ordered, shuffled or organized (an Ouster image with zero no-returns).
+                    Some(records) => setup.order_kitti(records, labels, &mut self.cloud, &mut self.report),
                     None => {
-                        let attributes =
-                            PointAttributes { intensity: Some(&flat.intensity), labels, ..PointAttributes::default() };
-                        setup.order_flat(path, &flat.points, &attributes, &mut self.cloud, &mut self.report)?;
+                        let records: Vec<[f32; 4]> =
+                            flat.points.iter().zip(&flat.intensity).map(|(p, &i)| [p.x, p.y, p.z, i]).collect();
+                        setup.order_kitti(&records, labels, &mut self.cloud, &mut self.report)
                     }
-                }
+                };
+                ordered.with_context(|| format!("ordering `{}`", path.display()))?;
                 self.ordered = true;
                 Ok(read_ms)
             }
@@ -295,7 +231,9 @@ impl FrameReader {
                 let rings = has_ring.then_some(c.ring.as_slice());
                 let attributes =
                     PointAttributes { intensity: Some(&c.intensity), labels, time_s: Some(&c.time_s), rings };
-                setup.order_flat(path, &c.point_in_vehicle, &attributes, &mut self.cloud, &mut self.report)?;
+                setup
+                    .order_flat(&c.point_in_vehicle, &attributes, &mut self.cloud, &mut self.report)
+                    .with_context(|| format!("ordering `{}`", path.display()))?;
                 self.ordered = true;
                 Ok(read_ms)
             }
@@ -308,7 +246,7 @@ impl FrameReader {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let frames = list_inputs(&args.input)?;
-    let setup = SensorSetup::new(args.rig.as_deref(), args.calibration.as_deref())?;
+    let setup = sensor_setup(args.rig.as_deref(), args.calibration.as_deref())?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating `{}`", args.out.display()))?;
     let mut reader = FrameReader::default();
     for f in &frames {

@@ -77,6 +77,13 @@ pub fn scan_standing(
 
 /// The classification method `name` (see `groundtruth list`) with its default parameters; `model`
 /// is a trained model file for `mcdaniel` (default: the bundled forest model). `seed` seeds RANSAC.
+/// Whether the method `name` takes a trained model file (`--model`).
+pub fn takes_model(name: &str) -> bool {
+    name == "mcdaniel"
+}
+
+/// Builds the method `name` (`seed` seeds RANSAC; `model`: a trained model file for the methods
+/// that take one, see [`takes_model`]).
 pub fn method(
     name: &str,
     seed: u64,

@@ -8,6 +8,7 @@ mod common;
 mod dataset;
 mod demo;
 mod eval;
+mod eval_dataset;
 mod eval_paper;
 mod list;
 mod render;
@@ -44,7 +45,7 @@ enum Command {
     Render(render::Args),
     /// Classify ground points in scanned clouds.
     Classify(classify::Args),
-    /// Scan, classify and score methods on a scene (Table I style), or a paper's evaluation (`--paper mcdaniel`).
+    /// Score methods: on a scanned scene (Table I style), on a labelled recording (`--dataset DIR`), or a paper's evaluation (`--paper mcdaniel`).
     Eval(eval::Args),
     /// Train a learning method (McDaniel et al.'s SVM) on scans and write the model (JSON).
     Train(train::Args),

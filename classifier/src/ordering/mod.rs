@@ -11,7 +11,9 @@
 //! - **ring fields** ([`table::ring_wishes`]): rows from a `ring` value per point (PCD / PLY of
 //!   the ROS drivers), ring 0 at the bottom or the top as the rings' elevations say;
 //! - **organized clouds** ([`organized`]) keep their cells; their rows are put in elevation order
-//!   from the `ring` field or the rows' elevations, whichever way up the file stores them;
+//!   from the `ring` field or the rows' elevations, whichever way up the file stores them; an
+//!   organized `.bin` (a whole sensor image with `0, 0, 0` no-returns, row by row or column by
+//!   column, as Ouster clouds converted to KITTI files are) is recognised ([`setup`]);
 //!
 //! The beam table comes from a rig, a built-in nominal table, or the sensor's own calibration file
 //! ([`calibration`]: our TOML or text format, the velodyne driver's YAML, Ouster's metadata JSON).
@@ -31,6 +33,7 @@ pub mod organized;
 pub mod placement;
 pub(crate) mod polar;
 pub mod report;
+pub mod setup;
 pub mod table;
 pub mod unfold;
 mod usable;
@@ -45,6 +48,7 @@ pub use input_point::InputPoint;
 pub use organized::{order_organized, order_organized_in_place, read_organized_into};
 pub use placement::PointAttributes;
 pub use report::{OrderingPath, OrderingReport};
+pub use setup::{KITTI_COLUMNS, OrganizedLayout, SensorSetup};
 pub use unfold::UnfoldParams;
 use unfold::Unfolded;
 use usable::Usable;

@@ -5,6 +5,7 @@ pub mod builtin;
 mod class;
 mod mesh;
 pub mod ply;
+pub mod semantic_kitti;
 
 pub use class::SemanticClass;
 pub use mesh::{SceneMesh, Surface};

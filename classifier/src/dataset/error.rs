@@ -1,0 +1,102 @@
+//! Errors of reading and scoring labelled datasets: each names the file, folder or flag at fault.
+
+use std::path::PathBuf;
+
+/// What is wrong with a dataset directory, a frame or an evaluation's options.
+#[derive(Debug, thiserror::Error)]
+pub enum DatasetError {
+    /// The directory is not in the SemanticKITTI layout.
+    #[error(
+        "`{dir}`: not a SemanticKITTI-layout dataset (expected `sequences/NN/velodyne/*.bin` or `velodyne/*.bin` in it)"
+    )]
+    NotADataset {
+        /// The directory given.
+        dir: PathBuf,
+    },
+    /// A sequence without a `labels/` folder.
+    #[error("`{dir}`: no `labels/` folder beside `velodyne/`: scoring needs labels")]
+    NoLabels {
+        /// The sequence folder.
+        dir: PathBuf,
+    },
+    /// A cloud without its label file.
+    #[error("`{bin}`: no label file `{label}`")]
+    MissingLabel {
+        /// The cloud.
+        bin: PathBuf,
+        /// The label file it needs.
+        label: PathBuf,
+    },
+    /// A sequence without frames.
+    #[error("`{dir}`: the sequence holds no `.bin` frames")]
+    EmptySequence {
+        /// The `velodyne/` folder.
+        dir: PathBuf,
+    },
+    /// `--sequences` names a sequence the dataset does not hold.
+    #[error("--sequences: no sequence `{id}` in `{dir}` (it holds: {known})")]
+    UnknownSequence {
+        /// The id asked for.
+        id: String,
+        /// The dataset root.
+        dir: PathBuf,
+        /// The sequences it holds.
+        known: String,
+    },
+    /// A `.bin` whose length is not a whole number of 16-byte records.
+    #[error("`{path}`: {bytes} bytes is not a whole number of 16-byte x y z intensity records (truncated?)")]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Its length.
+        bytes: u64,
+    },
+    /// A `.label` whose entry count differs from its cloud's point count.
+    #[error("`{label}` holds {labels} labels but `{bin}` {points} points")]
+    LabelCount {
+        /// The label file.
+        label: PathBuf,
+        /// Its entries.
+        labels: usize,
+        /// The cloud.
+        bin: PathBuf,
+        /// Its points.
+        points: usize,
+    },
+    /// A class id that SemanticKITTI does not define, given as ground or ignored.
+    #[error(
+        "{flag}: class id {id} is not a SemanticKITTI label id (known: 0, 1, 10, ..., 99, 252-259; see `groundtruth list`)"
+    )]
+    UnknownClass {
+        /// The flag or field.
+        flag: &'static str,
+        /// The id.
+        id: u32,
+    },
+    /// A bad option value.
+    #[error("{flag} = {value}: {allowed}")]
+    Invalid {
+        /// The flag or field.
+        flag: &'static str,
+        /// The value given.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
+    /// Reading a file failed.
+    #[error("`{path}`: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// Ordering or classifying a frame failed.
+    #[error("`{path}`: {source}")]
+    Classify {
+        /// The frame's cloud.
+        path: PathBuf,
+        /// The error.
+        source: crate::ClassifyError,
+    },
+}

@@ -1,0 +1,25 @@
+//! Labelled recordings in the SemanticKITTI layout, real or ours, and the scores of ground
+//! classification methods on them under a named protocol.
+//!
+//! - [`layout`]: which sequences and frames a directory holds (`DIR/sequences/NN/{velodyne,labels}`
+//!   or one sequence's `velodyne/` and `labels/`), and reading a frame's `.bin` and `.label`;
+//! - [`protocol`]: what counts as ground, what is ignored (`semantickitti`, `patchworkpp`,
+//!   `patchwork`);
+//! - [`score`]: per-point confusion counts per frame and pooled, with range bands;
+//! - [`evaluate`]: every frame read and ordered through the real-recordings path once, each
+//!   method run on it, each decision scored in the file's own point order.
+//!
+//! Frames are read as a user's recording is ([`crate::ordering::SensorSetup::order_kitti`]): scan
+//! unfolding, the beam table, or an organized sensor image, with `--rig` / `--calibration`.
+
+mod error;
+pub mod evaluate;
+pub mod layout;
+pub mod protocol;
+pub mod score;
+
+pub use error::DatasetError;
+pub use evaluate::{EvalOptions, FrameView, evaluate};
+pub use layout::{DatasetLayout, LabelledFrame, Sequence};
+pub use protocol::Protocol;
+pub use score::{FrameScore, MethodScore, RANGE_BAND_EDGES_M};

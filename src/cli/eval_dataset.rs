@@ -1,0 +1,203 @@
+//! `groundtruth eval --dataset DIR`: scores methods on a labelled recording in the SemanticKITTI
+//! layout (real, or written by `groundtruth dataset`), every frame read through the
+//! real-recordings path (`--rig`, `--calibration` as `classify` takes them), under a named
+//! protocol ([`classifier::dataset::protocol`]). Prints a table (pooled precision, recall, F1,
+//! IoU, accuracy; the frame mean of F1; the worst frame; F1 by range band; milliseconds per
+//! frame); `--json FILE` writes every number, per frame too, atomically; `--out DIR` draws each
+//! frame's outcome from above per method (`DIR/METHOD/SEQ_FRAME.png`: true, false and missed
+//! ground; points the protocol leaves out are not drawn).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use classifier::dataset::score::{RANGE_BANDS, band_name};
+use classifier::dataset::{DatasetLayout, EvalOptions, FrameView, MethodScore, Protocol, evaluate};
+
+/// What `eval --dataset` needs from the command line.
+pub struct DatasetArgs<'a> {
+    /// The dataset (root or one sequence).
+    pub dir: &'a Path,
+    /// Only these sequences.
+    pub sequences: Option<Vec<String>>,
+    /// Method names.
+    pub methods: Vec<String>,
+    /// Rig ordering the frames (name or file).
+    pub rig: Option<&'a str>,
+    /// The sensor's calibration file.
+    pub calibration: Option<&'a Path>,
+    /// Protocol name.
+    pub protocol: &'a str,
+    /// Ground classes replacing the protocol's.
+    pub ground: Option<&'a str>,
+    /// Sensor height for the `patchwork` protocol, metres.
+    pub sensor_height_m: f32,
+    /// Frames per sequence at most.
+    pub max_frames: Option<usize>,
+    /// JSON file.
+    pub json: Option<&'a Path>,
+    /// Picture folder.
+    pub out: Option<&'a Path>,
+    /// Model file for the learned methods.
+    pub model: Option<&'a Path>,
+    /// Print a line per frame.
+    pub details: bool,
+}
+
+/// Parses `--ground 40,44,...`.
+fn parse_ground(text: &str) -> anyhow::Result<Vec<u32>> {
+    super::common::split_list(text)
+        .iter()
+        .map(|s| s.parse::<u32>().with_context(|| format!("--ground: `{s}` is not a class id (e.g. 40,44,48)")))
+        .collect()
+}
+
+/// Runs `eval --dataset`.
+pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
+    let mut protocol = Protocol::named(args.protocol, args.sensor_height_m)?;
+    if let Some(g) = args.ground {
+        protocol = protocol.with_ground(&parse_ground(g)?)?;
+    }
+    if args.methods.is_empty() {
+        bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));
+    }
+    if args.max_frames == Some(0) {
+        bail!("--max-frames 0: allowed 1 or more");
+    }
+    // Unknown methods and bad models are refused before any frame is read.
+    let model = args.model;
+    let make = |name: &str| super::common::method(name, 0, model.filter(|_| super::common::takes_model(name)));
+    for m in &args.methods {
+        make(m)?;
+    }
+    let layout = DatasetLayout::open(args.dir, args.sequences.as_deref())?;
+    let setup = super::classify::sensor_setup(args.rig, args.calibration)?;
+    let frames: usize =
+        layout.sequences.iter().map(|s| s.frames.len().min(args.max_frames.unwrap_or(usize::MAX))).sum();
+    println!(
+        "dataset {}: {} sequence(s), {frames} frame(s); protocol {} (ground {}; left out {}{}; no-returns)",
+        args.dir.display(),
+        layout.sequences.len(),
+        protocol.name,
+        join(&protocol.ground),
+        join(&protocol.ignored),
+        protocol
+            .low_vegetation_below_z_m
+            .map_or(String::new(), |z| format!("; vegetation below z = {z:.3} m is ground")),
+    );
+    let options = EvalOptions { setup: &setup, protocol: &protocol, max_frames_per_sequence: args.max_frames };
+    let factory = |name: &str| make(name).map_err(|e| classifier::ClassifyError::Ordering(format!("{e:#}")));
+    let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
+    let scores = evaluate(&layout, &args.methods, &factory, &options, |view: &FrameView<'_>| {
+        if args.details {
+            let c = &view.score.scores.0;
+            println!(
+                "  {:<12} {}/{}  P {:.4} R {:.4} F1 {:.4}  {:.2} ms  {}",
+                view.method,
+                view.frame.sequence,
+                view.frame.stem,
+                c.precision(),
+                c.recall(),
+                c.f1(),
+                view.score.classify_ms,
+                view.report.summary()
+            );
+        }
+        if let Some(out) = args.out {
+            picture(out, view, &protocol, &sensor_from_vehicle).map_err(|e| {
+                classifier::dataset::DatasetError::Invalid {
+                    flag: "--out",
+                    value: out.display().to_string(),
+                    allowed: format!("a writable folder ({e:#})"),
+                }
+            })?;
+        }
+        Ok(())
+    })?;
+    print_table(&scores);
+    if let Some(path) = args.json {
+        let methods: BTreeMap<&str, &MethodScore> = scores.iter().map(|s| (s.method.as_str(), s)).collect();
+        let doc = serde_json::json!({
+            "dataset": args.dir.display().to_string(),
+            "protocol": protocol,
+            "rig": args.rig,
+            "calibration": args.calibration.map(|p| p.display().to_string()),
+            "range_bands": (0..RANGE_BANDS).map(band_name).collect::<Vec<_>>(),
+            "methods": methods,
+        });
+        sim::io::atomic::write_bytes_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())?;
+        println!("scores written to {}", path.display());
+    }
+    Ok(())
+}
+
+fn join(set: &std::collections::BTreeSet<u16>) -> String {
+    set.iter().map(u16::to_string).collect::<Vec<_>>().join(",")
+}
+
+fn print_table(scores: &[MethodScore]) {
+    let bands: Vec<String> = (0..RANGE_BANDS).map(|b| format!("F1 {}", band_name(b))).collect();
+    println!(
+        "{:<16} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10} {:>14} {:>10} {:>10} {:>10} {:>10} {:>9}",
+        "method",
+        "precision",
+        "recall",
+        "F1",
+        "IoU",
+        "acc",
+        "F1 mean",
+        "worst F1",
+        bands[0],
+        bands[1],
+        bands[2],
+        bands[3],
+        "ms/frame"
+    );
+    for s in scores {
+        let p = s.pooled();
+        let worst = s.worst_frame().map_or("-".to_string(), |f| format!("{:.4} {}", f.scores.0.f1(), f.frame));
+        let by = s.by_range();
+        println!(
+            "{:<16} {:>9.4} {:>7.4} {:>7.4} {:>7.4} {:>7.4} {:>10.4} {:>14} {:>10.4} {:>10.4} {:>10.4} {:>10.4} {:>9.2}",
+            s.method,
+            p.precision(),
+            p.recall(),
+            p.f1(),
+            p.iou(),
+            p.accuracy(),
+            s.frame_means().f1,
+            worst,
+            by[0].f1(),
+            by[1].f1(),
+            by[2].f1(),
+            by[3].f1(),
+            s.mean_classify_ms()
+        );
+    }
+}
+
+/// The frame's outcome from above: the cells the protocol scores, coloured by outcome.
+fn picture(
+    out: &Path,
+    view: &FrameView<'_>,
+    protocol: &Protocol,
+    sensor_from_vehicle: &glam::Affine3A,
+) -> anyhow::Result<()> {
+    let mut cloud = view.cloud.clone();
+    for i in 0..cloud.len() {
+        let p = cloud.point_in_vehicle[i];
+        if !p.is_finite() {
+            continue;
+        }
+        match protocol.truth(cloud.label[i].0, sensor_from_vehicle.transform_point3(p).z) {
+            Some(t) => cloud.ground[i] = t,
+            None => cloud.point_in_vehicle[i] = glam::Vec3::NAN,
+        }
+    }
+    let coloring = sim::picture::Coloring::Outcome { predicted_ground: view.ground };
+    let img = sim::picture::render_bev(&cloud, &coloring, &sim::picture::BevOptions::default())?;
+    let dir: PathBuf = out.join(view.method);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating `{}`", dir.display()))?;
+    sim::picture::save_png(&dir.join(format!("{}_{}.png", view.frame.sequence, view.frame.stem)), &img)?;
+    Ok(())
+}
