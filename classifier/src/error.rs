@@ -53,6 +53,12 @@ pub enum ClassifyError {
     /// A model file (or model) that cannot be used.
     #[error(transparent)]
     Model(#[from] crate::mcdaniel::ModelError),
+    /// A learned-method model file (or model) that cannot be used.
+    #[error(transparent)]
+    LearnedModel(#[from] crate::learned::LearnedModelError),
+    /// Training failed in the learning library.
+    #[error("training: {0}")]
+    Training(String),
     /// A beam table or unordered cloud that ordering recovery cannot use.
     #[error("ordering recovery: {0}")]
     Ordering(String),

@@ -18,6 +18,7 @@ pub mod baselines;
 mod cpu;
 pub mod dataset;
 pub mod error;
+pub mod learned;
 pub mod mcdaniel;
 pub mod methods;
 pub mod metrics;
@@ -28,6 +29,6 @@ pub mod synthetic;
 
 pub use error::{ClassifyError, Result};
 pub use mcdaniel::{McDaniel, McDanielModel, McDanielParams};
-pub use methods::{FrameInput, GroundClassifier, METHODS, mcdaniel_with_model, method_by_name};
+pub use methods::{FrameInput, GroundClassifier, METHODS, learned_with_model, mcdaniel_with_model, method_by_name};
 pub use metrics::{Confusion, Evaluation, Scores};
 pub use nitsch::{Nitsch, NitschParams};

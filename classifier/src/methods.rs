@@ -5,6 +5,7 @@ use glam::Affine3A;
 use crate::baselines::grid::{GridAccumulation, GridParams};
 use crate::baselines::ransac::{self, RansacParams};
 use crate::error::{ClassifyError, Result};
+use crate::learned::{Learned, LearnedModel};
 use crate::mcdaniel::{McDaniel, McDanielModel, McDanielParams};
 use crate::nitsch::{Nitsch, NitschParams, StageTimes};
 
@@ -18,6 +19,7 @@ pub const METHODS: &[&str] = &[
     "grid",
     "grid-no-cluster",
     "mcdaniel",
+    "learned",
 ];
 
 /// One frame to classify.
@@ -101,6 +103,26 @@ impl GroundClassifier for McDanielMethod {
     }
 }
 
+struct LearnedMethod(Learned);
+
+impl GroundClassifier for LearnedMethod {
+    fn name(&self) -> &'static str {
+        "learned"
+    }
+    fn classify(&mut self, frame: &FrameInput<'_>) -> Result<Vec<bool>> {
+        self.0.classify(frame.cloud)
+    }
+    fn named_stage_times(&self) -> Vec<(&'static str, f64)> {
+        vec![("nitsch_and_features", self.0.times.nitsch_and_features_s), ("trees", self.0.times.trees_s)]
+    }
+}
+
+/// The `learned` method with a given model (e.g. loaded from `--model FILE` with
+/// [`LearnedModel::load`]).
+pub fn learned_with_model(model: LearnedModel) -> Result<Box<dyn GroundClassifier + Send>> {
+    Ok(Box::new(LearnedMethod(Learned::new(model)?)))
+}
+
 /// The `mcdaniel` method with a given model (e.g. loaded from `--model FILE` with
 /// [`McDanielModel::load`]) and parameters.
 pub fn mcdaniel_with_model(model: McDanielModel, params: McDanielParams) -> Result<Box<dyn GroundClassifier + Send>> {
@@ -108,7 +130,8 @@ pub fn mcdaniel_with_model(model: McDanielModel, params: McDanielParams) -> Resu
 }
 
 /// Builds the method called `name` with its default parameters; `seed` seeds RANSAC. `mcdaniel`
-/// uses the bundled model trained on the forests ([`crate::mcdaniel::default_model`]).
+/// uses the bundled model trained on the forests ([`crate::mcdaniel::default_model`]), `learned`
+/// the bundled model trained on our scans ([`crate::learned::default_model`]).
 pub fn method_by_name(name: &str, seed: u64) -> Result<Box<dyn GroundClassifier + Send>> {
     let nitsch = |threshold: f32, cluster: bool| NitschParams { threshold, cluster, ..Default::default() };
     Ok(match name {
@@ -123,6 +146,7 @@ pub fn method_by_name(name: &str, seed: u64) -> Result<Box<dyn GroundClassifier 
             GridAccumulation::new(GridParams { cluster: false, ..Default::default() })?,
         )),
         "mcdaniel" => mcdaniel_with_model(crate::mcdaniel::default_model()?, McDanielParams::default())?,
+        "learned" => learned_with_model(crate::learned::default_model()?)?,
         _ => return Err(ClassifyError::UnknownMethod { name: name.to_string(), known: METHODS.join(", ") }),
     })
 }

@@ -6,6 +6,8 @@
 //! with `rho` the surface reflectivity, `theta` the incidence angle and `r_ref` the sensor's
 //! `intensity_reference_m` (targets nearer than `r_ref` saturate the range term).
 
+pub mod variation;
+
 use crate::sensor::Measurement;
 
 /// A measured return.

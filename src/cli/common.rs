@@ -79,7 +79,7 @@ pub fn scan_standing(
 /// is a trained model file for `mcdaniel` (default: the bundled forest model). `seed` seeds RANSAC.
 /// Whether the method `name` takes a trained model file (`--model`).
 pub fn takes_model(name: &str) -> bool {
-    name == "mcdaniel"
+    name == "mcdaniel" || name == "learned"
 }
 
 /// Builds the method `name` (`seed` seeds RANSAC; `model`: a trained model file for the methods
@@ -95,6 +95,12 @@ pub fn method(
             let model = classifier::McDanielModel::load(path)?;
             Ok(classifier::mcdaniel_with_model(model, classifier::McDanielParams::default())?)
         }
-        Some(path) => anyhow::bail!("--model `{}` applies to `mcdaniel` only, not to `{name}`", path.display()),
+        Some(path) if name == "learned" => {
+            let model = classifier::learned::LearnedModel::load(path)?;
+            Ok(classifier::learned_with_model(model)?)
+        }
+        Some(path) => {
+            anyhow::bail!("--model `{}` applies to `mcdaniel` and `learned`, not to `{name}`", path.display())
+        }
     }
 }

@@ -72,6 +72,18 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     }
     let layout = DatasetLayout::open(args.dir, args.sequences.as_deref())?;
     let setup = super::classify::sensor_setup(args.rig, args.calibration)?;
+    // A dataset of ours, without --rig: each sequence ordered with its own rig and mount.
+    let sequence_setups = match (args.rig, args.calibration) {
+        (None, None) => super::dataset::manifest_setups(args.dir)?,
+        _ => None,
+    };
+    if let Some(m) = &sequence_setups {
+        println!(
+            "{}: ordered with each sequence's rig and mount from its manifest ({} sequences)",
+            args.dir.display(),
+            m.len()
+        );
+    }
     let frames: usize =
         layout.sequences.iter().map(|s| s.frames.len().min(args.max_frames.unwrap_or(usize::MAX))).sum();
     println!(
@@ -85,7 +97,12 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
             .low_vegetation_below_z_m
             .map_or(String::new(), |z| format!("; vegetation below z = {z:.3} m is ground")),
     );
-    let options = EvalOptions { setup: &setup, protocol: &protocol, max_frames_per_sequence: args.max_frames };
+    let options = EvalOptions {
+        setup: &setup,
+        sequence_setups: sequence_setups.as_ref(),
+        protocol: &protocol,
+        max_frames_per_sequence: args.max_frames,
+    };
     let factory = |name: &str| make(name).map_err(|e| classifier::ClassifyError::Ordering(format!("{e:#}")));
     let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
     let scores = evaluate(&layout, &args.methods, &factory, &options, |view: &FrameView<'_>| {

@@ -19,6 +19,7 @@ mod scene;
 mod shard;
 mod sweep;
 mod train;
+mod train_learned;
 
 use clap::{Parser, Subcommand};
 
@@ -47,7 +48,7 @@ enum Command {
     Classify(classify::Args),
     /// Score methods: on a scanned scene (Table I style), on a labelled recording (`--dataset DIR`), or a paper's evaluation (`--paper mcdaniel`).
     Eval(eval::Args),
-    /// Train a learning method (McDaniel et al.'s SVM) on scans and write the model (JSON).
+    /// Train a learning method (McDaniel et al.'s SVM, or the learned method's trees) on our scans and write the model (JSON).
     Train(train::Args),
     /// Sensor-mount sensitivity sweeps: run (sharded, resumable), merge, plot, report.
     Sweep(sweep::Args),

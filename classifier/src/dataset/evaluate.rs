@@ -19,6 +19,9 @@ use crate::ordering::{CloudBuffer, OrderingReport, SensorSetup, decisions_per_po
 pub struct EvalOptions<'a> {
     /// Orders the frames (rig, calibration).
     pub setup: &'a SensorSetup,
+    /// Sequences ordered with a setup of their own (a dataset of ours: each sequence's rig and
+    /// mount from its manifest), by sequence id.
+    pub sequence_setups: Option<&'a std::collections::BTreeMap<String, SensorSetup>>,
     /// What counts as ground and what is left out.
     pub protocol: &'a Protocol,
     /// Score only the first frames of each sequence (`None`: all).
@@ -70,7 +73,7 @@ pub struct FrameView<'a> {
 /// let layout = DatasetLayout::open(dir.path(), None)?;
 /// let setup = SensorSetup::new(Some(&sim::Rig::load("vlp16-roof")?), None)?;
 /// let protocol = Protocol::named("semantickitti", 1.73)?;
-/// let options = EvalOptions { setup: &setup, protocol: &protocol, max_frames_per_sequence: None };
+/// let options = EvalOptions { setup: &setup, sequence_setups: None, protocol: &protocol, max_frames_per_sequence: None };
 /// let scores = evaluate(&layout, &["nitsch".to_string()], &|n| classifier::method_by_name(n, 0), &options, |_| Ok(()))?;
 /// assert_eq!(scores[0].pooled().tp + scores[0].pooled().fn_, 16 * 900);
 /// assert!(scores[0].pooled().recall() > 0.95);
@@ -96,13 +99,11 @@ pub fn evaluate(
             built.push(make(m).map_err(|source| DatasetError::Classify { path: sequence.dir.clone(), source })?);
         }
         let take = options.max_frames_per_sequence.unwrap_or(usize::MAX);
+        let setup = options.sequence_setups.and_then(|m| m.get(&sequence.id)).unwrap_or(options.setup);
         for (index, frame) in sequence.frames.iter().take(take).enumerate() {
             let (records, raw_labels) = frame.read()?;
             let classes: Vec<SemanticClass> = raw_labels.iter().map(|&l| SemanticClass((l & 0xFFFF) as u16)).collect();
-            options
-                .setup
-                .order_kitti(&records, Some(&classes), &mut buffer, &mut report)
-                .map_err(classify_error(frame))?;
+            setup.order_kitti(&records, Some(&classes), &mut buffer, &mut report).map_err(classify_error(frame))?;
             let cloud = buffer.cloud();
             for (method, score) in built.iter_mut().zip(scores.iter_mut()) {
                 let t = Instant::now();

@@ -123,6 +123,20 @@ impl SensorSpec {
         }
     }
 
+    /// The `measurement` overrides of the spec, to change (e.g. a noise level for a study).
+    pub fn measurement_params_mut(&mut self) -> &mut MeasurementParams {
+        match self {
+            Self::IbeoLux(s) => &mut s.measurement,
+            Self::Utm30lx(s) => &mut s.measurement,
+            Self::Utm30lxNodding(s) => &mut s.measurement,
+            Self::Vlp16(s) => &mut s.measurement,
+            Self::Hdl64e(s) => &mut s.measurement,
+            Self::Os1_64(s) => &mut s.measurement,
+            Self::Os1_128(s) => &mut s.measurement,
+            Self::Custom(s) => &mut s.measurement,
+        }
+    }
+
     /// The range measurement model (the model's defaults with the `measurement` overrides applied).
     pub fn measurement(&self) -> Measurement {
         match self {

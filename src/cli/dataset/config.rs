@@ -46,7 +46,14 @@ pub struct DatasetConfig {
     #[serde(default)]
     pub split: Option<Split>,
     /// The sequences.
+    #[serde(default)]
     pub sequences: Vec<SequenceConfig>,
+    /// Sequences drawn at random ([`super::generate`]), added after `sequences`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generate: Option<super::generate::Generate>,
+    /// Training parameters of `groundtruth train --config` (ignored by `groundtruth dataset`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub train: Option<super::generate::TrainSection>,
 }
 
 fn default_name() -> String {
@@ -119,16 +126,36 @@ pub struct SequenceConfig {
     /// No measurement effects.
     #[serde(default)]
     pub ideal: bool,
+    /// Range noise as a multiple of the sensor's own (`range_sigma_m`), 0 ..= 10.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_scale: Option<f64>,
+    /// Probability that a return is dropped at random, 0 ..= 0.9.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dropout: Option<f64>,
+    /// Intensities multiplied by this (clamped to 1), 0 ..= 10.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intensity_scale: Option<f64>,
 }
 
 impl DatasetConfig {
     /// Reads and checks the dataset file (fields only; scenes, rigs and trajectories are checked
-    /// by [`super::run`] once loaded).
+    /// by [`super::run`] once loaded); a `[generate]` table's sequences are drawn and added.
     pub fn load(path: &Path, allow_large: bool) -> anyhow::Result<Self> {
         let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        let config: DatasetConfig = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
+        let mut config: DatasetConfig = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
+        config.expand().with_context(|| format!("{}", path.display()))?;
         config.check(allow_large).with_context(|| format!("{}", path.display()))?;
         Ok(config)
+    }
+
+    /// Draws the `[generate]` table's sequences and appends them (ids after the largest given).
+    pub fn expand(&mut self) -> anyhow::Result<()> {
+        if let Some(g) = &self.generate {
+            let first = self.sequences.iter().map(|s| s.id + 1).max().unwrap_or(0);
+            let drawn = g.draw(first)?;
+            self.sequences.extend(drawn);
+        }
+        Ok(())
     }
 
     /// Checks ids, frame counts, speeds, waypoints and formats.
@@ -172,6 +199,17 @@ impl DatasetConfig {
                 }
                 if s.yaw_rate_deg_per_s != 0.0 {
                     bail!("`{at}`: give waypoints_m or yaw_rate_deg_per_s, not both");
+                }
+            }
+            for (name, value, max) in [
+                ("noise_scale", s.noise_scale, 10.0),
+                ("dropout", s.dropout, 0.9),
+                ("intensity_scale", s.intensity_scale, 10.0),
+            ] {
+                if let Some(v) = value
+                    && !(v.is_finite() && (0.0..=max).contains(&v))
+                {
+                    bail!("`{at}.{name}` = {v}: allowed 0 ..= {max}");
                 }
             }
             for f in &s.formats {

@@ -21,14 +21,17 @@ pub const LABEL_CONFIG: &str = "groundtruth.yaml";
 const MANIFEST_VERSION: u32 = 1;
 
 /// A sequence ready to scan.
-struct Prepared {
-    config: SequenceConfig,
-    rig: sim::Rig,
-    scan: ScanConfig,
+pub(crate) struct Prepared {
+    /// Its configuration.
+    pub config: SequenceConfig,
+    /// Its rig, mount and noise overrides applied.
+    pub rig: sim::Rig,
+    /// Its scan.
+    pub scan: ScanConfig,
 }
 
 /// Loads and checks every sequence; nothing is written.
-fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
+pub(crate) fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
     let mut out = Vec::with_capacity(config.sequences.len());
     for (k, s) in config.sequences.iter().enumerate() {
         let at = format!("sequences[{k}]");
@@ -36,6 +39,12 @@ fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
         let mut rig = crate::cli::common::load_rig(&s.rig).with_context(|| format!("`{at}.rig`"))?;
         if let Some(m) = &s.mount {
             apply_mount(&mut rig, m, &at)?;
+        }
+        if let Some(scale) = s.noise_scale {
+            for sensor in &mut rig.sensors {
+                let sigma = sensor.spec.measurement().range_sigma_m;
+                sensor.spec.measurement_params_mut().range_sigma_m = Some(sigma * scale as f32);
+            }
         }
         let scan = ScanConfig {
             seed: s.seed,
@@ -53,6 +62,19 @@ fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
         out.push(Prepared { config: s.clone(), rig, scan });
     }
     Ok(out)
+}
+
+/// Applies a sequence's random dropout and intensity scale to frame `k` (its noise scale is in
+/// the rig already).
+pub(crate) fn vary(cloud: &mut sim::OrderedCloud, s: &SequenceConfig, k: usize) -> anyhow::Result<()> {
+    if let Some(p) = s.dropout {
+        // The scan's own seed, on a stream of its own (Purpose::Dropout).
+        sim::effects::variation::drop_returns(cloud, p as f32, s.seed, k as u32)?;
+    }
+    if let Some(scale) = s.intensity_scale {
+        sim::effects::variation::scale_intensity(cloud, scale as f32)?;
+    }
+    Ok(())
 }
 
 /// The rig's frame period (its slowest sensor), seconds.
@@ -260,7 +282,8 @@ fn write_sequence(
             summary.frames_skipped += 1;
             continue;
         }
-        let frame = scanner.frame(k);
+        let mut frame = scanner.frame(k);
+        vary(&mut frame.cloud, s, k)?;
         let (bin_bytes, label_bytes, n) = sim::io::kitti::encode(&frame.cloud, cloud_from_vehicle.as_ref())?;
         write_bytes_atomic(&bin, &bin_bytes)?;
         for f in &s.formats {
