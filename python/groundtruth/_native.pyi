@@ -1,7 +1,7 @@
 """Type stubs of the native module ``groundtruth._native`` (re-exported by ``groundtruth``)."""
 
 from os import PathLike
-from typing import Mapping, Optional, Sequence, Union, final, overload
+from typing import Any, Mapping, Optional, Sequence, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,7 @@ __all__ = [
     "score",
     "regions",
     "classify",
+    "eval_dataset",
     "read",
     "write",
     "_time_rust_scan",
@@ -211,6 +212,23 @@ def classify(
     frame: Sequence[Frame], method: str = "nitsch", model: Optional[_Path] = None
 ) -> list[npt.NDArray[np.bool_]]:
     """One method instance over the frames in order (``grid`` accumulates its map)."""
+
+def eval_dataset(
+    path: _Path,
+    methods: Sequence[str] = ...,
+    *,
+    rig: Optional[str] = None,
+    calibration: Optional[_Path] = None,
+    protocol: str = "semantickitti",
+    ground: Optional[Sequence[int]] = None,
+    sensor_height_m: float = 1.73,
+    sequences: Optional[Sequence[str]] = None,
+    max_frames: Optional[int] = None,
+    model: Optional[_Path] = None,
+) -> dict[str, Any]:
+    """Score our methods (default ``nitsch`` and ``learned``) on a labelled SemanticKITTI-layout
+    recording, as ``groundtruth eval --dataset`` does; the dict is its ``--json`` document:
+    ``result["methods"]["learned"]["pooled"]["f1"]``, per frame under ``"frames"``."""
 
 def read(path: _Path) -> Frame:
     """Read a ``.pcd``, ``.ply``, ``.las`` or KITTI ``.bin`` (+ ``.label``) into a Frame; unorganized

@@ -14,33 +14,43 @@ use crate::error::{classify_error, type_error, value_error};
 use crate::frame::{Frame, grid_array};
 
 /// The method `name` with its default parameters, as the command line builds it: `model` is a
-/// trained model file for `mcdaniel` (default: the bundled forest model); RANSAC is seeded with
-/// the frame index.
-fn method(name: &str, model: Option<&PathBuf>) -> PyResult<Box<dyn GroundClassifier + Send>> {
+/// trained model file for `mcdaniel` (default: the bundled forest model) or `learned` (default:
+/// the bundled model); RANSAC is seeded with the frame index.
+pub fn method(name: &str, model: Option<&PathBuf>) -> PyResult<Box<dyn GroundClassifier + Send>> {
+    let exists = |path: &PathBuf| {
+        if path.is_file() {
+            Ok(())
+        } else {
+            Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!("model: {}: no such file", path.display())))
+        }
+    };
     match model {
         None => classifier::method_by_name(name, 0).map_err(classify_error),
         Some(path) if name == "mcdaniel" => {
-            if !path.is_file() {
-                return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!(
-                    "model: {}: no such file",
-                    path.display()
-                )));
-            }
+            exists(path)?;
             let model = classifier::McDanielModel::load(path)
                 .map_err(|e| classify_error(classifier::ClassifyError::Model(e)))?;
             classifier::mcdaniel_with_model(model, classifier::McDanielParams::default()).map_err(classify_error)
         }
-        Some(path) => {
-            Err(value_error("model", format!("`{}` applies to `mcdaniel` only, not to `{name}`", path.display())))
+        Some(path) if name == "learned" => {
+            exists(path)?;
+            let model = classifier::learned::LearnedModel::load(path)
+                .map_err(|e| classify_error(classifier::ClassifyError::LearnedModel(e)))?;
+            classifier::learned_with_model(model).map_err(classify_error)
         }
+        Some(path) => Err(value_error(
+            "model",
+            format!("`{}` applies to `mcdaniel` and `learned`, not to `{name}`", path.display()),
+        )),
     }
 }
 
 /// Classifies `frame` with our method `method` (`groundtruth.METHODS`: `nitsch`, `ransac`, `grid`,
-/// `mcdaniel`, ...); returns the decisions as a bool `(H, W)` array, True = ground (False where no
-/// return). Given a list of frames, one method instance classifies them in order and a list of
-/// arrays comes back (`grid` accumulates its map over the frames, as `groundtruth classify` does on
-/// a directory). `model`: a trained `mcdaniel` model file. The GIL is released while it runs.
+/// `mcdaniel`, `learned`, ...); returns the decisions as a bool `(H, W)` array, True = ground (False
+/// where no return). Given a list of frames, one method instance classifies them in order and a
+/// list of arrays comes back (`grid` accumulates its map over the frames, as `groundtruth classify`
+/// does on a directory). `model`: a trained `mcdaniel` or `learned` model file. The GIL is released
+/// while it runs.
 #[pyfunction]
 #[pyo3(signature = (frame, method="nitsch", model=None))]
 pub fn classify<'py>(

@@ -8,6 +8,7 @@
 mod args;
 mod classify;
 mod error;
+mod eval_dataset;
 mod frame;
 mod io;
 mod score;
@@ -134,6 +135,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(score::score, m)?)?;
     m.add_function(wrap_pyfunction!(score::regions, m)?)?;
     m.add_function(wrap_pyfunction!(classify::classify, m)?)?;
+    m.add_function(wrap_pyfunction!(eval_dataset::eval_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(io::read, m)?)?;
     m.add_function(wrap_pyfunction!(io::write, m)?)?;
     m.add_function(wrap_pyfunction!(_time_rust_scan, m)?)?;

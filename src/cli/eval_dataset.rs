@@ -7,12 +7,11 @@
 //! frame's outcome from above per method (`DIR/METHOD/SEQ_FRAME.png`: true, false and missed
 //! ground; points the protocol leaves out are not drawn).
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use classifier::dataset::score::{RANGE_BANDS, band_name};
-use classifier::dataset::{DatasetLayout, EvalOptions, FrameView, MethodScore, Protocol, evaluate};
+use classifier::dataset::{DatasetLayout, EvalOptions, FrameView, MethodScore, Protocol, evaluate, report};
 
 /// What `eval --dataset` needs from the command line.
 pub struct DatasetArgs<'a> {
@@ -133,15 +132,7 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     })?;
     print_table(&scores);
     if let Some(path) = args.json {
-        let methods: BTreeMap<&str, &MethodScore> = scores.iter().map(|s| (s.method.as_str(), s)).collect();
-        let doc = serde_json::json!({
-            "dataset": args.dir.display().to_string(),
-            "protocol": protocol,
-            "rig": args.rig,
-            "calibration": args.calibration.map(|p| p.display().to_string()),
-            "range_bands": (0..RANGE_BANDS).map(band_name).collect::<Vec<_>>(),
-            "methods": methods,
-        });
+        let doc = report(args.dir, &protocol, args.rig, args.calibration, &scores);
         sim::io::atomic::write_bytes_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())?;
         println!("scores written to {}", path.display());
     }

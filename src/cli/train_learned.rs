@@ -162,9 +162,16 @@ fn from_dataset(
     rig: Option<&str>,
     params: &TrainParams,
 ) -> anyhow::Result<(TrainingSet, serde_json::Value)> {
-    let layout = classifier::dataset::DatasetLayout::open(dir, None)?;
     // Each sequence's setup: from our manifest (rig and mount per sequence), else `--rig`.
-    let setups = match super::dataset::manifest_setups(dir)? {
+    let ours = super::dataset::manifest_setups(dir)?;
+    if ours.is_none() && rig.is_none() {
+        bail!(
+            "`{}` has no manifest.json of `groundtruth dataset`: give --rig to order its frames (and train only on scans of ours)",
+            dir.display()
+        );
+    }
+    let layout = classifier::dataset::DatasetLayout::open(dir, None)?;
+    let setups = match ours {
         Some(m) => m,
         None => {
             let Some(rig) = rig else {

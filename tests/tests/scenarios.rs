@@ -92,3 +92,37 @@ fn nitsch_on_the_270_deg_nodding_rig_finds_the_ground_as_at_180() {
         assert!(s270.f1 >= s180.f1 - 0.02, "{name}: F1 270 deg {} vs 180 deg {}", s270.f1, s180.f1);
     }
 }
+
+/// Nitsch's misses beside the car (issue 36, item 4). On real street frames (SemanticKITTI sequence
+/// 00, frames 0-2) nearly all of `nitsch`'s missed ground within 10 m of the sensor is not a ground
+/// candidate at all (947 of 958 in frame 0): its normal leans more than 25 deg (`g_rho` under the
+/// threshold), on curb faces and the kerb edges of sidewalks, which SemanticKITTI labels sidewalk
+/// (ground). Ordering, neighbours and clustering are not the cause (11 of 958 sit in rejected
+/// clusters of 1-3 points). It is the paper's method: ground is where the surface normal is
+/// near-vertical, and a curb's face is vertical. Our city's curbs are labelled the same way
+/// (sidewalk), and the test keeps the limit measured: `nitsch` finds few curb-face returns near
+/// the sensor (measured: 0.105 of 1,358 within 15 m), the learned method, which has seen curbs
+/// labelled ground, most of them (0.946).
+#[test]
+fn curb_faces_are_sidewalk_that_normals_cannot_call_ground() {
+    let faces = |s: &gt_tests::Scenario| -> (usize, usize) {
+        let (c, d) = (&s.frames[0].cloud, &s.decisions[0]);
+        // Curb faces near the sensor: sidewalk returns whose true normal is horizontal.
+        let face: Vec<usize> = (0..c.len())
+            .filter(|&i| {
+                c.has_return(i)
+                    && c.label[i] == sim::SemanticClass::SIDEWALK
+                    && c.normal[i].z.abs() < 0.3
+                    && c.range_m[i] < 15.0
+            })
+            .collect();
+        (face.len(), face.iter().filter(|&&i| d[i]).count())
+    };
+    let (n, nitsch) = faces(&run("city", "hdl64e-roof", "nitsch", 1, 0.0));
+    let (_, learned) = faces(&run("city", "hdl64e-roof", "learned", 1, 0.0));
+    let (rn, rl) = (nitsch as f64 / n as f64, learned as f64 / n as f64);
+    eprintln!("curb faces within 15 m: {n}; nitsch finds {rn:.3}, learned {rl:.3}");
+    assert!(n >= 100, "curb faces seen: {n}");
+    assert!(rn <= 0.5, "nitsch finds {rn} of the curb faces: the documented limit changed");
+    assert!(rl >= 0.7, "learned finds {rl} of the curb faces");
+}

@@ -140,3 +140,27 @@ pub fn evaluate(
     }
     Ok(scores)
 }
+
+/// The document of an evaluation, as `groundtruth eval --dataset --json` writes it and the Python
+/// package returns it: `{"dataset", "protocol", "rig", "calibration", "range_bands", "methods":
+/// {NAME: {"pooled": {"precision", "recall", "f1", "iou", "accuracy", "tp", "fp", "tn", "fn",
+/// "points"}, "frame_mean", "by_range", "worst_frame", "mean_classify_ms", "frames": [...]}}}`.
+pub fn report(
+    dataset: &std::path::Path,
+    protocol: &Protocol,
+    rig: Option<&str>,
+    calibration: Option<&std::path::Path>,
+    scores: &[MethodScore],
+) -> serde_json::Value {
+    use super::score::{RANGE_BANDS, band_name};
+    let methods: std::collections::BTreeMap<&str, &MethodScore> =
+        scores.iter().map(|s| (s.method.as_str(), s)).collect();
+    serde_json::json!({
+        "dataset": dataset.display().to_string(),
+        "protocol": protocol,
+        "rig": rig,
+        "calibration": calibration.map(|p| p.display().to_string()),
+        "range_bands": (0..RANGE_BANDS).map(band_name).collect::<Vec<_>>(),
+        "methods": methods,
+    })
+}

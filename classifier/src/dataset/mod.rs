@@ -7,7 +7,8 @@
 //!   `patchwork`);
 //! - [`score`]: per-point confusion counts per frame and pooled, with range bands;
 //! - [`evaluate`]: every frame read and ordered through the real-recordings path once, each
-//!   method run on it, each decision scored in the file's own point order.
+//!   method run on it, each decision scored in the file's own point order;
+//! - [`ours`]: a dataset `groundtruth dataset` wrote orders each sequence with its own rig.
 //!
 //! Frames are read as a user's recording is ([`crate::ordering::SensorSetup::order_kitti`]): scan
 //! unfolding, the beam table, or an organized sensor image, with `--rig` / `--calibration`.
@@ -15,11 +16,12 @@
 mod error;
 pub mod evaluate;
 pub mod layout;
+pub mod ours;
 pub mod protocol;
 pub mod score;
 
 pub use error::DatasetError;
-pub use evaluate::{EvalOptions, FrameView, evaluate};
+pub use evaluate::{EvalOptions, FrameView, evaluate, report};
 pub use layout::{DatasetLayout, LabelledFrame, Sequence};
 pub use protocol::Protocol;
 pub use score::{FrameScore, MethodScore, RANGE_BAND_EDGES_M};

@@ -48,7 +48,9 @@ pub struct TrainParams {
     pub validation_every: usize,
     /// Seed of the sampling and of the library.
     pub seed: u64,
-    /// Worker threads (`None`: all cores). The model is the same at any count.
+    /// Worker threads (`None`: all cores). The model is the same at any count (so the model file
+    /// does not record it).
+    #[serde(skip)]
     pub threads: Option<usize>,
 }
 

@@ -72,38 +72,12 @@ pub enum Command {
     },
 }
 
-/// The sensor setup of every sequence of a dataset of ours (`DIR/manifest.json` written by
-/// `groundtruth dataset`: each sequence's rig with its mount overrides), by sequence folder name;
-/// `None` where `dir` holds no such manifest (a recording of someone else's).
+/// The sensor setup of every sequence of a dataset of ours (see
+/// [`classifier::dataset::ours::sequence_setups`]).
 pub fn manifest_setups(
     dir: &std::path::Path,
 ) -> anyhow::Result<Option<std::collections::BTreeMap<String, classifier::ordering::SensorSetup>>> {
-    use anyhow::Context;
-    let path = dir.join(write::MANIFEST);
-    if !path.is_file() {
-        return Ok(None);
-    }
-    let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path)?).with_context(|| format!("`{}`", path.display()))?;
-    if m.get("format").and_then(|f| f.as_str()) != Some("groundtruth SemanticKITTI-layout dataset") {
-        return Ok(None);
-    }
-    let config: config::DatasetConfig = serde_json::from_value(m["config"].clone())
-        .with_context(|| format!("`{}`: not a manifest of `groundtruth dataset`", path.display()))?;
-    let mut out = std::collections::BTreeMap::new();
-    for s in &config.sequences {
-        let mut rig = super::common::load_rig(&s.rig)?;
-        if rig.sensors.len() != 1 {
-            // A multi-sensor rig's frames are in the vehicle frame: no mount to apply; its beams
-            // do not make one table, so such a sequence is ordered with the default setup.
-            continue;
-        }
-        if let Some(mo) = &s.mount {
-            config::apply_mount(&mut rig, mo, &format!("sequence {}", s.id))?;
-        }
-        out.insert(format!("{:02}", s.id), classifier::ordering::SensorSetup::new(Some(&rig), None)?);
-    }
-    Ok(Some(out))
+    Ok(classifier::dataset::ours::sequence_setups(dir)?)
 }
 
 /// Runs `groundtruth dataset`.
