@@ -90,14 +90,18 @@ def test_bad_regions(frame):
 def test_bad_classify(frame, tmp_path):
     with pytest.raises(ValueError, match="no-such-method"):
         gt.classify(frame, "no-such-method")
-    with pytest.raises(ValueError, match="model: .* applies to `mcdaniel` only"):
+    with pytest.raises(ValueError, match="model: .* applies to `mcdaniel` and `learned`, not to `nitsch`"):
         gt.classify(frame, "nitsch", model="m.json")
+    with pytest.raises(FileNotFoundError, match="model"):
+        gt.classify(frame, "learned", model=tmp_path / "missing.json")
     with pytest.raises(FileNotFoundError, match="model"):
         gt.classify(frame, "mcdaniel", model=tmp_path / "missing.json")
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
     with pytest.raises(ValueError, match="bad.json"):
         gt.classify(frame, "mcdaniel", model=bad)
+    with pytest.raises(ValueError, match="bad.json"):
+        gt.classify(frame, "learned", model=bad)
     with pytest.raises(TypeError, match="method"):
         gt.classify(frame, 3)
     with pytest.raises(TypeError, match="frame: expected a Frame or a list of Frames, got str"):

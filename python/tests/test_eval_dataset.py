@@ -80,3 +80,12 @@ def test_bad_datasets_and_options_are_refused(dataset, tmp_path):
     (seq / "labels").rmdir()
     with pytest.raises(FileNotFoundError, match="labels"):
         gt.eval_dataset(pathlib.Path(tmp_path / "bad"), ["nitsch"])
+
+
+def test_the_learned_method_keeps_the_down_ramp(ramp_hdl):
+    # The README's scenario: the bundled model keeps the ramp surface, and calls the whole frame
+    # at least as well as nitsch.
+    learned = gt.classify(ramp_hdl, "learned")
+    assert learned.shape == ramp_hdl.xyz.shape[:2]
+    assert gt.score(ramp_hdl, learned, region="ramp-surface").recall >= 0.95
+    assert gt.score(ramp_hdl, learned).f1 >= gt.score(ramp_hdl, gt.classify(ramp_hdl, "nitsch")).f1 - 0.005
