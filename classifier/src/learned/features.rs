@@ -102,7 +102,7 @@ fn steepest(
         let d2 = (dx * dx + dy * dy).max(1e-8);
         let g = (sign * dz * dz.abs() / d2).clamp(-half, half);
         // NaN (no return there) compares false: keep what is there.
-        *o = if zo[k] == zo[k] { g } else { *o };
+        *o = if zo[k].is_nan() { *o } else { g };
     }
 }
 

@@ -215,7 +215,7 @@ impl OrganizedLayout {
     /// ```
     pub fn detect(records: &[[f32; 4]], beams: usize) -> Option<Self> {
         let n = records.len();
-        if beams < 2 || n % beams != 0 || n / beams < 16 {
+        if beams < 2 || !n.is_multiple_of(beams) || n / beams < 16 {
             return None;
         }
         if !records.iter().any(|p| p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0) {
@@ -278,7 +278,7 @@ mod tests {
     fn image(beams: usize, cols: usize, column_major: bool) -> Vec<[f32; 4]> {
         let layout = OrganizedLayout { rows: beams, cols, column_major };
         let mut out = vec![[0.0f32; 4]; beams * cols];
-        for k in 0..beams * cols {
+        for (k, record) in out.iter_mut().enumerate() {
             let cell = layout.cell_of_record(k);
             let (row, col) = (cell / cols, cell % cols);
             // Row 0 is the top beam (ouster-ros order).
@@ -289,7 +289,7 @@ mod tests {
             let t = if dir.z < -0.01 { (1.7 / -dir.z).min(30.0) } else { 30.0 };
             let p = dir * t;
             if k % 7 != 3 {
-                out[k] = [p.x, p.y, p.z, 0.5];
+                *record = [p.x, p.y, p.z, 0.5];
             }
         }
         out
