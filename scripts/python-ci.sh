@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The Python package's CI: a venv with maturin, numpy, pytest, pypatchworkpp and mypy from PyPI, the
+# The Python package's CI: a venv with maturin, numpy, pytest, pypatchworkpp, mypy and the ROS 2 bag
+# clients (mcap + mcap-ros2-support, rosbags, rerun-sdk) from PyPI, the
 # `groundtruth` package installed from python/ (the README's `pip install` line, release build),
 # then mypy's stubtest (the .pyi stubs against the built module) and pytest on python/tests (the
 # package's tests, including round trips against the command-line program's files) and
@@ -27,9 +28,10 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 py="$venv/bin/python"
 export PATH="$venv/bin:$PATH"  # the maturin build backend runs the `maturin` program
-log "pip install maturin numpy pytest pypatchworkpp"
+log "pip install maturin numpy pytest pypatchworkpp mypy, and the ROS 2 bag clients (mcap, rosbags, rerun)"
 "$py" -m pip install -q --upgrade pip
-"$py" -m pip install -q "maturin>=1.9,<2" numpy pytest "pypatchworkpp==1.4.1" mypy
+"$py" -m pip install -q "maturin>=1.9,<2" numpy pytest "pypatchworkpp==1.4.1" mypy \
+  "mcap==1.6.0" "mcap-ros2-support==0.6.0" "rosbags==0.11.9" "rerun-sdk==0.41.0"
 
 log "cargo build --release --bin groundtruth (the CLI of the round-trip tests)"
 cargo build --release --locked --bin groundtruth

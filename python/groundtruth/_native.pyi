@@ -230,13 +230,18 @@ def eval_dataset(
     recording, as ``groundtruth eval --dataset`` does; the dict is its ``--json`` document:
     ``result["methods"]["learned"]["pooled"]["f1"]``, per frame under ``"frames"``."""
 
-def read(path: _Path) -> Frame:
+def read(path: _Path, topic: Optional[str] = None) -> Union[Frame, list[Frame]]:
     """Read a ``.pcd``, ``.ply``, ``.las`` or KITTI ``.bin`` (+ ``.label``) into a Frame; unorganized
-    files give a ``(1, N)`` grid in file order."""
+    files give a ``(1, N)`` grid in file order. A ROS 2 bag (``.mcap`` or a rosbag2 directory) gives
+    a list of Frames, one per PointCloud2 message of ``topic``."""
 
-def write(frame: Frame, path: _Path, format: Optional[str] = None) -> int:
+def write(
+    frame: Union[Frame, Sequence[Frame]], path: _Path, format: Optional[str] = None, layout: str = "groundtruth"
+) -> int:
     """Write the frame as ``pcd``, ``pcd-ascii``, ``ply``, ``kitti`` (``.bin`` + ``.label``
-    [+ ``.calib.txt``]) or ``las``; returns the points written."""
+    [+ ``.calib.txt``]), ``las``, or ``mcap`` (a ROS 2 bag directory of one frame or a list of
+    frames); ``layout`` (``groundtruth``, ``velodyne``, ``ouster``) for PCD and bags; returns the
+    points written."""
 
 def _time_rust_scan(scene: str, rig: str, repeats: int = 5, ideal: bool = False) -> list[float]:
     """Benchmark helper: seconds of ``repeats`` scans through the Rust API alone."""

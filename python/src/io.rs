@@ -7,11 +7,11 @@ use groundtruth_scenario::Scan;
 use pyo3::prelude::*;
 use sim::io::pcd::PcdLayout;
 
-use crate::error::{sim_error, value_error};
+use crate::error::{sim_error, type_error, value_error};
 use crate::frame::Frame;
 
 /// The formats `write` takes.
-pub const WRITE_FORMATS: [&str; 5] = ["pcd", "pcd-ascii", "ply", "kitti", "las"];
+pub const WRITE_FORMATS: [&str; 6] = ["pcd", "pcd-ascii", "ply", "kitti", "las", "mcap"];
 
 fn extension(path: &Path) -> String {
     path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
@@ -22,8 +22,79 @@ fn extension(path: &Path) -> String {
 /// labels and ground truth). Unorganized files give a `1 x N` grid in file order. Regions that need a scene
 /// family (`ramp-surface`, ...) are not available on a file; `ground`, `class:...` and the others
 /// are, from the file's labels. The GIL is released while reading.
+///
+/// A ROS 2 bag (an `.mcap` file or a rosbag2 directory) gives a list of Frames, one per
+/// `sensor_msgs/msg/PointCloud2` message of `topic` (optional where the bag has one such topic),
+/// each read as the PCD of the same cloud would be.
 #[pyfunction]
-pub fn read(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
+#[pyo3(signature = (path, topic=None))]
+pub fn read<'py>(py: Python<'py>, path: PathBuf, topic: Option<String>) -> PyResult<Bound<'py, PyAny>> {
+    if sim::io::ros2::is_bag(&path) {
+        let frames = read_bag(py, &path, topic)?;
+        return Ok(pyo3::types::PyList::new(py, frames)?.into_any());
+    }
+    if topic.is_some() {
+        return Err(value_error(
+            "topic",
+            format!("applies to a bag (.mcap or rosbag2 directory); {} is none", path.display()),
+        ));
+    }
+    Ok(Bound::new(py, read_file(py, path)?)?.into_any())
+}
+
+/// The PointCloud2 messages of a bag's topic as Frames.
+fn read_bag(py: Python<'_>, path: &Path, topic: Option<String>) -> PyResult<Vec<Frame>> {
+    let p = path.to_path_buf();
+    let clouds = py
+        .detach(move || -> Result<Vec<sim::OrderedCloud>, String> {
+            let bag = sim::io::ros2::Bag::open(&p).map_err(|e| e.to_string())?;
+            let topic = match topic {
+                Some(t) => t,
+                None => {
+                    let topics = bag.pointcloud_topics().map_err(|e| e.to_string())?;
+                    match topics.as_slice() {
+                        [one] => one.name.clone(),
+                        _ => {
+                            let names: Vec<&str> = topics.iter().map(|t| t.name.as_str()).collect();
+                            return Err(format!(
+                                "topic: give one of the bag's PointCloud2 topics: {}",
+                                names.join(", ")
+                            ));
+                        }
+                    }
+                }
+            };
+            let mut out = Vec::new();
+            bag.for_each_cloud(&topic, |m| {
+                let bad = |e: String| sim::SimError::bad_file(&p, format!("{topic} message {}: {e}", m.index));
+                let pc = m.decode().map_err(bad)?;
+                let pcd = sim::io::ros2::pointcloud2::to_pcd(&pc, m.groundtruth_comment.as_deref()).map_err(bad)?;
+                out.push(sim::io::pcd::read_bytes(&p, &pcd)?);
+                Ok(())
+            })
+            .map_err(|e| e.to_string())?;
+            Ok(out)
+        })
+        .map_err(|e| value_error("path", e))?;
+    let name = path.display().to_string();
+    Ok(clouds
+        .into_iter()
+        .map(|cloud| {
+            let frame = sim::scan::Frame {
+                index: 0,
+                start_time_s: 0.0,
+                vehicle_pose: Default::default(),
+                world_from_vehicle: glam::Affine3A::IDENTITY,
+                cloud,
+            };
+            let rig = sim::Rig { name: String::new(), sensors: Vec::new() };
+            Frame { scan: Arc::new(Scan::from_frames(vec![frame], &name, rig)), k: 0 }
+        })
+        .collect())
+}
+
+/// Reads one point-cloud file (see [`read`]).
+fn read_file(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
     let ext = extension(&path);
     if !path.is_file() {
         return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!("path: {}: no such file", path.display())));
@@ -67,9 +138,70 @@ pub fn read(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
 /// KITTI writes `path` (`.bin`), the `.label` beside it and, for a single-sensor rig, the
 /// `.calib.txt` (points in the sensor frame, as the command line writes them). Returns the number of
 /// points written. The GIL is released while writing.
+///
+/// `mcap` writes a ROS 2 bag (a rosbag2 directory at `path`: `metadata.yaml` and one MCAP file)
+/// holding the frame, or every frame of a list in order, as `groundtruth scan --format mcap`
+/// writes a scan: one PointCloud2 per frame and sensor in `layout` (`groundtruth`, `velodyne`,
+/// `ouster`), `/tf` and `/tf_static`.
 #[pyfunction]
-#[pyo3(signature = (frame, path, format=None))]
-pub fn write(py: Python<'_>, frame: &Frame, path: PathBuf, format: Option<&str>) -> PyResult<usize> {
+#[pyo3(signature = (frame, path, format=None, layout="groundtruth"))]
+pub fn write(
+    py: Python<'_>,
+    frame: &Bound<'_, PyAny>,
+    path: PathBuf,
+    format: Option<&str>,
+    layout: &str,
+) -> PyResult<usize> {
+    let layout = PcdLayout::parse(layout).map_err(|e| value_error("layout", e))?;
+    if format.is_some_and(|f| f.eq_ignore_ascii_case("mcap")) {
+        let frames: Vec<PyRef<'_, Frame>> = if let Ok(f) = frame.cast::<Frame>() {
+            vec![f.borrow()]
+        } else {
+            frame
+                .try_iter()
+                .map_err(|_| type_error("frame", "expected a Frame or a list of Frames"))?
+                .map(|f| f.and_then(|f| Ok(f.cast::<Frame>()?.borrow())))
+                .collect::<PyResult<_>>()
+                .map_err(|_| type_error("frame", "expected a Frame or a list of Frames"))?
+        };
+        let work: Vec<(Arc<Scan>, usize)> = frames.iter().map(|f| (f.scan.clone(), f.k)).collect();
+        return py
+            .detach(move || -> Result<usize, sim::SimError> {
+                let mut bag = sim::io::ros2::BagWriter::create(&path)?;
+                let mut points = 0;
+                for (k, (scan, i)) in work.iter().enumerate() {
+                    let f = &scan.frames()[*i];
+                    let mut sensors = sim::io::ros2::scan::sensor_topics(scan.rig());
+                    if sensors.is_empty() {
+                        // A file read back: one sensor at the vehicle's origin.
+                        sensors.push(sim::io::ros2::scan::SensorTopic {
+                            name: "lidar".into(),
+                            topic: "/lidar/points".into(),
+                            vehicle_from_sensor: glam::Affine3A::IDENTITY,
+                        });
+                    }
+                    if k == 0 {
+                        sim::io::ros2::scan::write_static(&mut bag, &sensors)?;
+                    }
+                    let written = sim::io::ros2::scan::write_frame(
+                        &mut bag,
+                        &f.cloud,
+                        &sensors,
+                        layout,
+                        f.start_time_s,
+                        &f.world_from_vehicle,
+                    )?;
+                    points += written.iter().map(|w| w.1).sum::<usize>();
+                }
+                bag.finish()?;
+                Ok(points)
+            })
+            .map_err(sim_error);
+    }
+    let frame: PyRef<'_, Frame> = frame
+        .cast::<Frame>()
+        .map_err(|_| type_error("frame", "expected a Frame (a list only with format=\"mcap\")"))?
+        .borrow();
     let format = match format {
         Some(f) => f.to_ascii_lowercase(),
         None => match extension(&path).as_str() {
@@ -97,7 +229,7 @@ pub fn write(py: Python<'_>, frame: &Frame, path: PathBuf, format: Option<&str>)
             (rig.sensors.len() == 1).then(|| rig.sensors[0].mount.vehicle_from_sensor().inverse());
         match format.as_str() {
             "pcd" | "pcd-ascii" => {
-                sim::io::pcd::write_layout(&path, cloud, PcdLayout::Groundtruth, format == "pcd-ascii", None)
+                sim::io::pcd::write_layout(&path, cloud, layout, format == "pcd-ascii", sensor_from_vehicle.as_ref())
             }
             "ply" => sim::io::ply::write(&path, cloud),
             "las" => sim::io::las::write(&path, cloud),

@@ -58,9 +58,14 @@ pub struct Args {
     /// Seed of randomized methods (RANSAC).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Trained model file for `mcdaniel` (`groundtruth train`; default: the bundled forest model).
+    /// Trained model file for `mcdaniel` or `learned` (`groundtruth train`; default: the bundled
+    /// model).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// With a bag (`.mcap` or a rosbag2 directory) as `--input`: the PointCloud2 topic to classify
+    /// (missing or wrong: the bag's PointCloud2 topics are listed).
+    #[arg(long)]
+    topic: Option<String>,
 }
 
 struct InputFrame {
@@ -163,39 +168,11 @@ impl FrameReader {
         self.ordered = false;
         match path.extension().and_then(|e| e.to_str()) {
             Some("pcd") => {
-                let bytes = self.bytes.load(path)?;
+                let FrameReader { bytes, file_cloud, cloud, report, ordered, .. } = self;
+                let bytes = bytes.load(path)?;
                 let frame = sim::io::pcd::PcdFrame::parse(path, bytes)?;
-                let (info, (rows, _, planes)) = (frame.info(), frame.shape());
-                if info.organized && !info.ours && planes == 1 {
-                    // A driver's organized cloud: its rows are put in order as it is decoded, so
-                    // `read_ms` is the file's read and the header, the rest counts as ordering.
-                    let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-                    if let Some(n) = setup.calibrated_lasers
-                        && n != rows
-                    {
-                        bail!("`{}` has {rows} rows but the calibration file {n} lasers", path.display());
-                    }
-                    read_organized_into(&frame, setup.vehicle_from_sensor, self.cloud.cloud_mut(), &mut self.report)
-                        .with_context(|| format!("ordering the rows of `{}`", path.display()))?;
-                    self.ordered = true;
-                    return Ok(read_ms);
-                }
-                let info = frame.read_into(&mut self.file_cloud, None, Affine3A::IDENTITY)?;
-                let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-                if info.ours || self.file_cloud.planes > 1 {
-                    std::mem::swap(self.cloud.cloud_mut(), &mut self.file_cloud);
-                    return Ok(read_ms);
-                }
-                // An unorganized PCD: ordered as a KITTI file is.
-                let c = &self.file_cloud;
-                let labels = c.label.iter().any(|l| l.0 != 0).then_some(c.label.as_slice());
-                let rings = info.has_ring.then_some(c.ring.as_slice());
-                let attributes =
-                    PointAttributes { intensity: Some(&c.intensity), labels, time_s: Some(&c.time_s), rings };
-                setup
-                    .order_flat(&c.point_in_vehicle, &attributes, &mut self.cloud, &mut self.report)
-                    .with_context(|| format!("ordering `{}`", path.display()))?;
-                self.ordered = true;
+                let (read_ms, from_another_tool) = order_pcd(path, &frame, setup, file_cloud, cloud, report, t0)?;
+                *ordered = from_another_tool;
                 Ok(read_ms)
             }
             Some("bin") => {
@@ -242,9 +219,76 @@ impl FrameReader {
     }
 }
 
+impl FrameReader {
+    /// Reads a PCD held in `bytes` (a bag's PointCloud2 as PCD bytes; `name` names it in errors)
+    /// and orders it as [`FrameReader::read`] orders a `.pcd` file; returns the milliseconds of
+    /// the parse.
+    pub fn read_pcd_bytes(&mut self, name: &Path, bytes: &[u8], setup: &SensorSetup) -> anyhow::Result<f64> {
+        let t0 = std::time::Instant::now();
+        let frame = sim::io::pcd::PcdFrame::parse(name, bytes)?;
+        let (read_ms, ordered) =
+            order_pcd(name, &frame, setup, &mut self.file_cloud, &mut self.cloud, &mut self.report, t0)?;
+        self.ordered = ordered;
+        Ok(read_ms)
+    }
+}
+
+/// Orders a parsed PCD `frame` into `cloud`: a driver's organized cloud has its rows put in order
+/// as it is decoded; our own layout (or several echo planes) is taken as it is; an unorganized
+/// cloud is ordered as a KITTI file is, or from its `ring` field. Returns the milliseconds of the
+/// read (since `t0`) and whether the cloud came from another tool (then `report` holds what
+/// ordering did).
+#[allow(clippy::too_many_arguments)]
+fn order_pcd(
+    path: &Path,
+    frame: &sim::io::pcd::PcdFrame<'_>,
+    setup: &SensorSetup,
+    file_cloud: &mut OrderedCloud,
+    cloud: &mut CloudBuffer,
+    report: &mut OrderingReport,
+    t0: std::time::Instant,
+) -> anyhow::Result<(f64, bool)> {
+    let (info, (rows, _, planes)) = (frame.info(), frame.shape());
+    if info.organized && !info.ours && planes == 1 {
+        // A driver's organized cloud: its rows are put in order as it is decoded, so `read_ms` is
+        // the file's read and the header, the rest counts as ordering.
+        let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+        if let Some(n) = setup.calibrated_lasers
+            && n != rows
+        {
+            bail!("`{}` has {rows} rows but the calibration file {n} lasers", path.display());
+        }
+        read_organized_into(frame, setup.vehicle_from_sensor, cloud.cloud_mut(), report)
+            .with_context(|| format!("ordering the rows of `{}`", path.display()))?;
+        return Ok((read_ms, true));
+    }
+    let info = frame.read_into(file_cloud, None, Affine3A::IDENTITY)?;
+    let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+    if info.ours || file_cloud.planes > 1 {
+        std::mem::swap(cloud.cloud_mut(), file_cloud);
+        return Ok((read_ms, false));
+    }
+    // An unorganized PCD: ordered as a KITTI file is.
+    let c = &*file_cloud;
+    let labels = c.label.iter().any(|l| l.0 != 0).then_some(c.label.as_slice());
+    let rings = info.has_ring.then_some(c.ring.as_slice());
+    let attributes = PointAttributes { intensity: Some(&c.intensity), labels, time_s: Some(&c.time_s), rings };
+    setup
+        .order_flat(&c.point_in_vehicle, &attributes, cloud, report)
+        .with_context(|| format!("ordering `{}`", path.display()))?;
+    Ok((read_ms, true))
+}
+
 /// Runs `groundtruth classify`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
+    if sim::io::ros2::is_bag(&args.input) {
+        let setup = sensor_setup(args.rig.as_deref(), args.calibration.as_deref())?;
+        return super::classify_bag::run(&args.input, args.topic.as_deref(), &args.out, &setup, method.as_mut());
+    }
+    if args.topic.is_some() {
+        bail!("--topic applies to a bag (an .mcap file or a rosbag2 directory); `{}` is none", args.input.display());
+    }
     let frames = list_inputs(&args.input)?;
     let setup = sensor_setup(args.rig.as_deref(), args.calibration.as_deref())?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating `{}`", args.out.display()))?;

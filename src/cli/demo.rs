@@ -51,6 +51,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ideal: false,
         format: "pcd,ply,kitti,las".into(),
         pcd_layout: "groundtruth".into(),
+        bag_compression: "zstd".into(),
         threads: None,
         backend: "bvh".into(),
     };

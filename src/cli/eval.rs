@@ -54,6 +54,10 @@ pub struct Args {
     /// With `--dataset --protocol patchwork`: the sensor's height above the ground, metres.
     #[arg(long, default_value_t = 1.73, requires = "dataset")]
     sensor_height: f32,
+    /// With `--dataset BAG` (an `.mcap` or rosbag2 directory): the PointCloud2 topic (its clouds
+    /// carry a `label` field).
+    #[arg(long, requires = "dataset")]
+    topic: Option<String>,
     /// With `--dataset`: score at most this many frames per sequence.
     #[arg(long, requires = "dataset")]
     max_frames: Option<usize>,
@@ -118,6 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             out: args.out.as_deref(),
             model: args.model.as_deref(),
             details: args.details,
+            topic: args.topic.as_deref(),
         });
     }
     if args.out.is_some() {

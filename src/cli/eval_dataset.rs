@@ -41,6 +41,8 @@ pub struct DatasetArgs<'a> {
     pub model: Option<&'a Path>,
     /// Print a line per frame.
     pub details: bool,
+    /// With a bag as the dataset: the PointCloud2 topic (its clouds carry a `label` field).
+    pub topic: Option<&'a str>,
 }
 
 /// Parses `--ground 40,44,...`.
@@ -68,6 +70,12 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     let make = |name: &str| super::common::method(name, 0, model.filter(|_| super::common::takes_model(name)));
     for m in &args.methods {
         make(m)?;
+    }
+    if sim::io::ros2::is_bag(args.dir) {
+        return run_bag(args, &protocol, &make);
+    }
+    if args.topic.is_some() {
+        bail!("--topic applies to a bag (an .mcap file or a rosbag2 directory); `{}` is none", args.dir.display());
     }
     let layout = DatasetLayout::open(args.dir, args.sequences.as_deref())?;
     let setup = super::classify::sensor_setup(args.rig, args.calibration)?;
@@ -133,6 +141,121 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     print_table(&scores);
     if let Some(path) = args.json {
         let doc = report(args.dir, &protocol, args.rig, args.calibration, &scores);
+        sim::io::atomic::write_bytes_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())?;
+        println!("scores written to {}", path.display());
+    }
+    Ok(())
+}
+
+/// `eval --dataset BAG --topic TOPIC`: every PointCloud2 message of the topic read as `classify`
+/// reads it, scored per return of its grid against its own `label` field (SemanticKITTI ids, as our
+/// layouts and most labelled conversions carry them) under the protocol; the vegetation rule of
+/// `patchwork` uses the height in the message's frame.
+fn run_bag(
+    args: &DatasetArgs<'_>,
+    protocol: &Protocol,
+    make: &dyn Fn(&str) -> anyhow::Result<Box<dyn classifier::GroundClassifier + Send>>,
+) -> anyhow::Result<()> {
+    use classifier::dataset::FrameScore;
+    let bag = sim::io::ros2::Bag::open(args.dir)?;
+    let Some(topic) = args.topic else { bail!("{}", super::classify_bag::topics_message(&bag)?) };
+    if args.out.is_some() {
+        bail!("--out (outcome pictures) applies to SemanticKITTI-layout datasets, not to bags");
+    }
+    let setup = super::classify::sensor_setup(args.rig, args.calibration)?;
+    let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
+    let mut methods = Vec::new();
+    for m in &args.methods {
+        methods.push(make(m)?);
+    }
+    let mut scores: Vec<MethodScore> =
+        args.methods.iter().map(|m| MethodScore { method: m.clone(), frames: Vec::new() }).collect();
+    let mut reader = super::classify::FrameReader::default();
+    let (mut skipped, mut fatal) = (0usize, None::<anyhow::Error>);
+    let take = args.max_frames.unwrap_or(usize::MAX);
+    bag.for_each_cloud(topic, |m| {
+        if m.index >= take {
+            return Ok(());
+        }
+        let step = (|| -> anyhow::Result<bool> {
+            let file = args.dir.display();
+            let Ok(pc) = m.decode().map_err(|e| eprintln!("`{file}` {topic} message {}: {e}; skipped", m.index)) else {
+                return Ok(false);
+            };
+            if !pc.fields.iter().any(|f| f.name == "label") {
+                bail!("`{}` {topic} message {}: no `label` field: scoring needs labels", args.dir.display(), m.index);
+            }
+            let Ok(pcd) = sim::io::ros2::pointcloud2::to_pcd(&pc, m.groundtruth_comment.as_deref())
+                .map_err(|e| eprintln!("`{file}` {topic} message {}: {e}; skipped", m.index))
+            else {
+                return Ok(false);
+            };
+            let name = std::path::PathBuf::from(format!("{}#{topic}[{}]", args.dir.display(), m.index));
+            if let Err(e) = reader.read_pcd_bytes(&name, &pcd, &setup) {
+                eprintln!("`{file}` {topic} message {}: {e:#}; skipped", m.index);
+                return Ok(false);
+            }
+            let cloud = reader.cloud();
+            for (method, score) in methods.iter_mut().zip(scores.iter_mut()) {
+                let t = std::time::Instant::now();
+                let ground =
+                    method.classify(&classifier::FrameInput { index: m.index, cloud, world_from_vehicle: None })?;
+                let mut fs = FrameScore {
+                    sequence: topic.to_string(),
+                    frame: format!("{:06}", m.index),
+                    classify_ms: t.elapsed().as_secs_f64() * 1e3,
+                    ..FrameScore::default()
+                };
+                for (i, &g) in ground.iter().enumerate() {
+                    let p = cloud.point_in_vehicle[i];
+                    if !p.is_finite() || p == glam::Vec3::ZERO {
+                        fs.no_returns += u64::from(cloud.has_return(i));
+                        continue;
+                    }
+                    let q = sensor_from_vehicle.transform_point3(p);
+                    fs.add(protocol.truth(cloud.label[i].0, q.z), g, q.length());
+                }
+                if args.details {
+                    let c = &fs.scores.0;
+                    println!(
+                        "  {:<12} {topic}[{}]  P {:.4} R {:.4} F1 {:.4}",
+                        score.method,
+                        m.index,
+                        c.precision(),
+                        c.recall(),
+                        c.f1()
+                    );
+                }
+                score.frames.push(fs);
+            }
+            Ok(true)
+        })();
+        match step {
+            Ok(true) => {}
+            Ok(false) => skipped += 1,
+            Err(e) => {
+                fatal = Some(e);
+                return Err(sim::SimError::invalid("message", m.index, "a labelled message"));
+            }
+        }
+        Ok(())
+    })
+    .map_err(|e| fatal.take().unwrap_or_else(|| e.into()))?;
+    if let Some(e) = fatal {
+        return Err(e);
+    }
+    if scores.first().is_none_or(|s| s.frames.is_empty()) {
+        bail!("no message of `{topic}` in `{}` could be scored ({skipped} skipped)", args.dir.display());
+    }
+    println!(
+        "bag {} topic {topic}: {} message(s) scored, {skipped} skipped; protocol {}",
+        args.dir.display(),
+        scores.first().map_or(0, |s| s.frames.len()),
+        protocol.name
+    );
+    print_table(&scores);
+    if let Some(path) = args.json {
+        let doc = report(args.dir, protocol, args.rig, args.calibration, &scores);
         sim::io::atomic::write_bytes_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())?;
         println!("scores written to {}", path.display());
     }

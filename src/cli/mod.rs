@@ -4,6 +4,7 @@ mod bench;
 mod bench_classify;
 mod bench_scan;
 mod classify;
+mod classify_bag;
 mod common;
 mod dataset;
 mod demo;

@@ -35,16 +35,23 @@ pub struct Args {
     /// Turn measurement effects off (exact distances, no noise, no quantisation, no dropout).
     #[arg(long)]
     pub ideal: bool,
-    /// Files to write per frame: any of pcd, pcd-ascii, ply, kitti, las (comma-separated).
+    /// Files to write per frame: any of pcd, pcd-ascii, ply, kitti, las (comma-separated); `mcap`
+    /// writes the whole scan as a ROS 2 bag (`bag/`: rosbag2 with one MCAP file; the clouds in the
+    /// `--pcd-layout`, one topic per sensor, `/tf`, `/tf_static`).
     #[arg(long, default_value = "pcd")]
     pub format: String,
     /// Layout of the organized PCD: `groundtruth` (ours: rows bottom-first, every field, NaN
     /// no-returns), `velodyne` (velodyne_pointcloud's organized PointXYZIRT: ring 0 = bottom, NaN
     /// no-returns) or `ouster` (ouster-ros: row 0 = ring 0 = the top beam, zero no-returns, `range`
     /// in millimetres). The driver layouts hold sensor-frame points for a single-sensor rig, plane 0
-    /// only, plus our `label` field; the manifest's `pcd_layout` says which was written.
+    /// only, plus our `label` field; the manifest's `pcd_layout` says which was written. Also the
+    /// layout of the bag's clouds.
     #[arg(long, default_value = "groundtruth")]
     pub pcd_layout: String,
+    /// Chunk compression of the bag (`--format mcap`): `zstd` (level 1, as `ros2 bag record -s
+    /// mcap` writes) or `none` (larger files, no compression work).
+    #[arg(long, default_value = "zstd")]
+    pub bag_compression: String,
     /// Worker threads (default: all cores). Results are identical at any count.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -93,6 +100,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The rosbag2 directory of `--format mcap` inside the output directory (`bag/bag_0.mcap`).
+pub const BAG_DIR: &str = "bag";
+
 /// Scans as `args` says, writes every frame's files and the manifest into `args.out`, and returns the manifest.
 pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
     let mut formats = Formats::parse(&args.format)?;
@@ -116,10 +126,38 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
     let single = rig.sensors.len() == 1;
     let sensor_from_vehicle = single.then(|| rig.sensors[0].mount.vehicle_from_sensor().inverse());
     let mut frames = Vec::with_capacity(args.frames);
+    // The bag: every frame's clouds, its pose and the mounts (sim::io::ros2::scan).
+    let sensor_topics = sim::io::ros2::scan::sensor_topics(&rig);
+    let mut bag = match formats.mcap {
+        true => {
+            let compression = sim::io::ros2::BagCompression::parse(&args.bag_compression)?;
+            let mut b = sim::io::ros2::BagWriter::create_with(&args.out.join(BAG_DIR), compression)?;
+            sim::io::ros2::scan::write_static(&mut b, &sensor_topics)?;
+            Some(b)
+        }
+        false => None,
+    };
     for k in 0..args.frames {
         let frame = scanner.frame(k);
         let ctx = FrameContext { index: k, sensor_from_vehicle };
-        let files = sim::io::formats::write_frame(&args.out, &frame.cloud, &ctx, &formats)?;
+        let mut files = sim::io::formats::write_frame(&args.out, &frame.cloud, &ctx, &formats)?;
+        if let Some(b) = bag.as_mut() {
+            let written = sim::io::ros2::scan::write_frame(
+                b,
+                &frame.cloud,
+                &sensor_topics,
+                formats.pcd_layout,
+                frame.start_time_s,
+                &frame.world_from_vehicle,
+            )?;
+            for (topic, points) in written {
+                files.push(sim::io::formats::WrittenFile {
+                    file: format!("{BAG_DIR}/{BAG_DIR}_0.mcap"),
+                    format: format!("mcap:{topic}"),
+                    points,
+                });
+            }
+        }
         let file = files.first().map(|f| f.file.clone()).unwrap_or_default();
         frames.push(FrameEntry {
             index: k,
@@ -133,6 +171,9 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
             world_from_vehicle: matrix_rows(&frame.world_from_vehicle),
             files,
         });
+    }
+    if let Some(b) = bag {
+        b.finish()?;
     }
     let layout = scanner.layout();
     let sensors = rig

@@ -32,13 +32,16 @@ pub struct Formats {
     pub las: bool,
     /// LAZ (compressed LAS 1.4, same content; needs the `laz` cargo feature).
     pub laz: bool,
+    /// A ROS 2 bag of the whole scan (rosbag2 directory `bag/`, [`super::ros2`]); written by the
+    /// scan, not per frame: [`write_frame`] leaves it to the caller.
+    pub mcap: bool,
     /// Layout of the organized PCD: ours (default) or a ROS driver's ([`super::pcd::PcdLayout`]).
     pub pcd_layout: super::pcd::PcdLayout,
 }
 
 impl Formats {
     /// The names [`Formats::parse`] accepts.
-    pub const NAMES: [&'static str; 6] = ["pcd", "pcd-ascii", "ply", "kitti", "las", "laz"];
+    pub const NAMES: [&'static str; 7] = ["pcd", "pcd-ascii", "ply", "kitti", "las", "laz", "mcap"];
 
     /// Parses a comma-separated list such as `pcd,ply,kitti,las` (`pcd-ascii` = PCD in ASCII).
     /// Unknown names are refused with the list of allowed ones; an empty list is refused.
@@ -54,18 +57,19 @@ impl Formats {
                 "ply" => f.ply = true,
                 "kitti" => f.kitti = true,
                 "las" => f.las = true,
+                "mcap" => f.mcap = true,
                 "laz" if cfg!(feature = "laz") => f.laz = true,
                 "laz" => {
                     return Err(SimError::invalid(
                         "format",
                         "laz",
-                        "pcd, pcd-ascii, ply, kitti, las (this build has no LAZ: build with `--features sim/laz`)",
+                        "pcd, pcd-ascii, ply, kitti, las, mcap (this build has no LAZ: build with `--features sim/laz`)",
                     ));
                 }
                 _ => return Err(SimError::invalid("format", name, Self::NAMES.join(", "))),
             }
         }
-        if !(f.pcd || f.ply || f.kitti || f.las || f.laz) {
+        if !(f.pcd || f.ply || f.kitti || f.las || f.laz || f.mcap) {
             return Err(SimError::invalid(
                 "format",
                 format!("`{list}`"),

@@ -17,3 +17,4 @@ pub mod pcd;
 pub mod ply;
 pub(crate) mod plyfile;
 mod read_util;
+pub mod ros2;

@@ -15,7 +15,8 @@
 //! speed_m_per_s = 10.0                 # constant speed, 0 ..= 100 m/s
 //! yaw_rate_deg_per_s = 0.0             # constant yaw rate (|w| <= 114 deg/s), or:
 //! waypoints_m = [[0, 0], [60, 0], [80, 20]]   # a polyline the ego follows at speed_m_per_s (> 0)
-//! formats = ["pcd"]                    # optional extra files per frame: pcd, ply, las
+//! formats = ["pcd"]                    # optional extra files per frame: pcd, ply, las; `mcap`:
+//!                                      # the sequence as a ROS 2 bag, sequences/NN/bag/
 //! ideal = false                        # optional: no measurement effects
 //! ```
 //!
@@ -213,8 +214,8 @@ impl DatasetConfig {
                 }
             }
             for f in &s.formats {
-                if !["pcd", "ply", "las"].contains(&f.as_str()) {
-                    bail!("`{at}.formats`: unknown format `{f}`; allowed: pcd, ply, las");
+                if !["pcd", "ply", "las", "mcap"].contains(&f.as_str()) {
+                    bail!("`{at}.formats`: unknown format `{f}`; allowed: pcd, ply, las, mcap");
                 }
             }
         }

@@ -208,9 +208,20 @@ fn peak_rss_mb() -> f64 {
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
+/// The rosbag2 directory of a sequence whose `formats` has `mcap` (`sequences/NN/bag/`).
+pub const BAG_DIR: &str = "bag";
+
 /// Checks everything, claims `out` and writes this shard's frames.
 pub fn generate(config: &DatasetConfig, out: &Path, shard: Shard, resume: bool) -> anyhow::Result<Summary> {
     let t0 = Instant::now();
+    if shard != Shard::ALL
+        && let Some(s) = config.sequences.iter().find(|s| s.formats.iter().any(|f| f == "mcap"))
+    {
+        bail!(
+            "sequence {}: `formats` has `mcap`, a bag of the whole sequence, which one shard cannot write; run it without --shard, or drop mcap",
+            s.id
+        );
+    }
     let prepared = prepare(config)?;
     let manifest = manifest(config, &prepared)?;
     claim(out, &manifest, &super::labels::yaml(&config.split_or_default()))?;
@@ -256,7 +267,7 @@ fn write_sequence(
     let vehicle_from_cloud =
         if single { DAffine3::from_mat4(glam::Mat4::from(vehicle_from_sensor).as_dmat4()) } else { DAffine3::IDENTITY };
     let mut dirs = vec![seq.join("velodyne"), seq.join("labels")];
-    dirs.extend(s.formats.iter().map(|f| seq.join(f)));
+    dirs.extend(s.formats.iter().filter(|f| *f != "mcap").map(|f| seq.join(f)));
     for d in &dirs {
         std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
     }
@@ -270,6 +281,18 @@ fn write_sequence(
     write_bytes_atomic(&seq.join("poses.txt"), poses.as_bytes())?;
     write_bytes_atomic(&seq.join("times.txt"), times.as_bytes())?;
     write_bytes_atomic(&seq.join("calib.txt"), CALIB.as_bytes())?;
+    // The bag (`formats` has `mcap`): the whole sequence in our layout, written with every frame;
+    // a resumed run keeps a finished bag and otherwise rescans the sequence's frames for it.
+    let bag_dir = seq.join(BAG_DIR);
+    let topics = sim::io::ros2::scan::sensor_topics(&p.rig);
+    let mut bag = match s.formats.iter().any(|f| f == "mcap") && !(resume && bag_dir.join("metadata.yaml").is_file()) {
+        true => {
+            let mut b = sim::io::ros2::BagWriter::create(&bag_dir)?;
+            sim::io::ros2::scan::write_static(&mut b, &topics)?;
+            Some(b)
+        }
+        false => None,
+    };
     for k in 0..frames {
         if !shard.contains(first + k as u64) {
             continue;
@@ -278,7 +301,7 @@ fn write_sequence(
         let stem = format!("{k:06}");
         let bin = seq.join("velodyne").join(format!("{stem}.bin"));
         let label = seq.join("labels").join(format!("{stem}.label"));
-        if resume && label.is_file() && bin.is_file() {
+        if resume && bag.is_none() && label.is_file() && bin.is_file() {
             summary.frames_skipped += 1;
             continue;
         }
@@ -291,13 +314,28 @@ fn write_sequence(
             match f.as_str() {
                 "pcd" => sim::io::pcd::write(&path, &frame.cloud, false).map(|_| ())?,
                 "ply" => sim::io::ply::write(&path, &frame.cloud).map(|_| ())?,
-                _ => sim::io::las::write_with(&path, &frame.cloud, false).map(|_| ())?,
+                "las" => sim::io::las::write_with(&path, &frame.cloud, false).map(|_| ())?,
+                _ => {
+                    if let Some(b) = bag.as_mut() {
+                        sim::io::ros2::scan::write_frame(
+                            b,
+                            &frame.cloud,
+                            &topics,
+                            sim::io::pcd::PcdLayout::Groundtruth,
+                            frame.start_time_s,
+                            &frame.world_from_vehicle,
+                        )?;
+                    }
+                }
             }
         }
         // Last: the frame is complete once its `.label` exists.
         write_bytes_atomic(&label, &label_bytes)?;
         summary.frames_written += 1;
         summary.points_written += n as u64;
+    }
+    if let Some(b) = bag {
+        b.finish()?;
     }
     Ok(())
 }
