@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use super::messages::{
     POINTCLOUD2, PointCloud2, TF_MESSAGE, TfMessage, from_cdr, pointcloud2_definition, tf_message_definition, to_cdr,
 };
+use super::stream::Messages;
 use crate::error::{Result, SimError};
 
 /// QoS of an ordinary topic (reliable, volatile), as rosbag2 records it.
@@ -426,31 +427,17 @@ impl Bag {
 
     /// The bag's topics with their types and message counts (every message is read).
     pub fn topics(&self) -> Result<Vec<TopicInfo>> {
+        // The summary sections list channels and counts without reading the messages; files
+        // without one (a writer that skipped it) are read through.
+        if let Some(topics) = self.summary_topics() {
+            return Ok(topics);
+        }
         let mut topics: BTreeMap<String, TopicInfo> = BTreeMap::new();
         for file in &self.files {
             let bytes = Self::read(file)?;
-            // The summary section lists channels and counts without reading the messages; a file
-            // without one (a writer that skipped it) is read through.
-            let summary = mcap::Summary::read(&bytes).ok().flatten();
-            if let Some(summary) = summary.filter(|s| s.stats.is_some()) {
-                let counts = summary.stats.as_ref().map(|s| s.channel_message_counts.clone()).unwrap_or_default();
-                for (id, channel) in &summary.channels {
-                    let ty = channel.schema.as_ref().map_or(String::new(), |s| s.name.clone());
-                    topics
-                        .entry(channel.topic.clone())
-                        .or_insert_with(|| TopicInfo {
-                            name: channel.topic.clone(),
-                            ty,
-                            encoding: channel.message_encoding.clone(),
-                            count: 0,
-                        })
-                        .count += counts.get(id).copied().unwrap_or(0);
-                }
-                continue;
-            }
-            for m in mcap::MessageStream::new(&bytes).map_err(|e| bag_error(file, e))? {
+            for m in Messages::new(&bytes) {
                 let m = m.map_err(|e| bag_error(file, format!("corrupt or truncated MCAP: {e}")))?;
-                let ty = m.channel.schema.as_ref().map_or(String::new(), |s| s.name.clone());
+                let ty = m.channel.schema.clone();
                 topics
                     .entry(m.channel.topic.clone())
                     .or_insert_with(|| TopicInfo {
@@ -470,56 +457,116 @@ impl Bag {
         Ok(self.topics()?.into_iter().filter(|t| t.ty == POINTCLOUD2 && t.encoding == "cdr").collect())
     }
 
-    /// Calls `each` with every message of `topic`, in log-time order within each file. Refused,
-    /// naming the topics there are: a topic that is not in the bag, or not PointCloud2 in `cdr`
-    /// (ROS 1, JSON, ...). A corrupt or truncated file stops the reading with an error naming the
-    /// file and the message index reached.
-    pub fn for_each_cloud(&self, topic: &str, mut each: impl FnMut(BagCloud) -> Result<()>) -> Result<usize> {
-        let mut index = 0usize;
-        let mut found = false;
+    /// The topics from the files' summary sections, without reading a message; `None` where a
+    /// file has none (or a damaged one).
+    fn summary_topics(&self) -> Option<Vec<TopicInfo>> {
+        let mut topics: BTreeMap<String, TopicInfo> = BTreeMap::new();
         for file in &self.files {
-            let bytes = Self::read(file)?;
-            let stream = mcap::MessageStream::new(&bytes).map_err(|e| bag_error(file, e))?;
-            for m in stream {
-                let m = m.map_err(|e| {
-                    bag_error(file, format!("corrupt or truncated MCAP after message {index} of `{topic}`: {e}"))
-                })?;
-                if m.channel.topic != topic {
-                    continue;
-                }
-                let ty = m.channel.schema.as_ref().map_or("", |s| s.name.as_str());
-                if ty != POINTCLOUD2 || m.channel.message_encoding != "cdr" {
-                    return Err(bag_error(
-                        file,
-                        format!(
-                            "topic `{topic}` holds `{ty}` in `{}`, not sensor_msgs/msg/PointCloud2 in cdr (ROS 2)",
-                            m.channel.message_encoding
-                        ),
-                    ));
-                }
-                found = true;
-                let comment = m.channel.metadata.get(GROUNDTRUTH_KEY).cloned();
-                each(BagCloud {
-                    index,
-                    log_time_ns: m.log_time,
-                    cdr: m.data.into_owned(),
-                    groundtruth_comment: comment,
-                })?;
-                index += 1;
+            let bytes = Self::read(file).ok()?;
+            let summary = mcap::Summary::read(&bytes).ok().flatten()?;
+            let counts = summary.stats.as_ref()?.channel_message_counts.clone();
+            for (id, channel) in &summary.channels {
+                topics
+                    .entry(channel.topic.clone())
+                    .or_insert_with(|| TopicInfo {
+                        name: channel.topic.clone(),
+                        ty: channel.schema.as_ref().map_or(String::new(), |s| s.name.clone()),
+                        encoding: channel.message_encoding.clone(),
+                        count: 0,
+                    })
+                    .count += counts.get(id).copied().unwrap_or(0);
             }
         }
-        if !found {
-            let names: Vec<String> =
-                self.pointcloud_topics()?.into_iter().map(|t| format!("{} ({} messages)", t.name, t.count)).collect();
-            return Err(bag_error(
-                &self.path,
-                format!(
-                    "no PointCloud2 topic `{topic}`; the bag's PointCloud2 topics: {}",
-                    if names.is_empty() { "none".to_string() } else { names.join(", ") }
-                ),
-            ));
+        Some(topics.into_values().collect())
+    }
+
+    fn no_such_topic(&self, topic: &str) -> SimError {
+        let names: Vec<String> = self
+            .pointcloud_topics()
+            .map(|t| t.into_iter().map(|t| format!("{} ({} messages)", t.name, t.count)).collect())
+            .unwrap_or_default();
+        bag_error(
+            &self.path,
+            format!(
+                "no PointCloud2 topic `{topic}`; the bag's PointCloud2 topics: {}",
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            ),
+        )
+    }
+
+    fn wrong_type(file: &Path, topic: &str, ty: &str, encoding: &str) -> SimError {
+        bag_error(
+            file,
+            format!("topic `{topic}` holds `{ty}` in `{encoding}`, not sensor_msgs/msg/PointCloud2 in cdr (ROS 2)"),
+        )
+    }
+
+    /// Calls `each` with every message of `topic`, in the order they were written (file by
+    /// file). Refused, naming the topics there are: a topic that is not in the bag, or not
+    /// PointCloud2 in `cdr` (ROS 1, JSON, ...). A corrupt or truncated file stops the reading with
+    /// an error naming the file and the message index reached. The MCAP is read and its chunks
+    /// decompressed on a thread of its own, a message or two ahead of `each`.
+    pub fn for_each_cloud(&self, topic: &str, mut each: impl FnMut(BagCloud) -> Result<()>) -> Result<usize> {
+        if let Some(topics) = self.summary_topics() {
+            match topics.iter().find(|t| t.name == topic) {
+                None => return Err(self.no_such_topic(topic)),
+                Some(t) if t.ty != POINTCLOUD2 || t.encoding != "cdr" => {
+                    return Err(Self::wrong_type(&self.path, topic, &t.ty, &t.encoding));
+                }
+                Some(_) => {}
+            }
         }
-        Ok(index)
+        let files = &self.files;
+        let count = std::thread::scope(|scope| -> Result<usize> {
+            let (sender, receiver) = std::sync::mpsc::sync_channel::<Result<BagCloud>>(2);
+            scope.spawn(move || {
+                let mut index = 0usize;
+                let result = (|| -> Result<()> {
+                    for file in files {
+                        let bytes = Self::read(file)?;
+                        for m in Messages::new(&bytes) {
+                            let m = m.map_err(|e| {
+                                bag_error(
+                                    file,
+                                    format!("corrupt or truncated MCAP after message {index} of `{topic}`: {e}"),
+                                )
+                            })?;
+                            if m.channel.topic != topic {
+                                continue;
+                            }
+                            let ty = m.channel.schema.as_str();
+                            if ty != POINTCLOUD2 || m.channel.message_encoding != "cdr" {
+                                return Err(Self::wrong_type(file, topic, ty, &m.channel.message_encoding));
+                            }
+                            let cloud = BagCloud {
+                                index,
+                                log_time_ns: m.log_time_ns,
+                                cdr: m.data.into_owned(),
+                                groundtruth_comment: m.channel.metadata.get(GROUNDTRUTH_KEY).cloned(),
+                            };
+                            if sender.send(Ok(cloud)).is_err() {
+                                return Ok(()); // the reader stopped
+                            }
+                            index += 1;
+                        }
+                    }
+                    Ok(())
+                })();
+                if let Err(e) = result {
+                    let _ = sender.send(Err(e));
+                }
+            });
+            let mut count = 0usize;
+            for cloud in receiver {
+                each(cloud?)?;
+                count += 1;
+            }
+            Ok(count)
+        })?;
+        if count == 0 {
+            return Err(self.no_such_topic(topic));
+        }
+        Ok(count)
     }
 }
 

@@ -7,6 +7,7 @@ pub mod bag;
 pub mod messages;
 pub mod pointcloud2;
 pub mod scan;
+pub mod stream;
 
 pub use bag::{Bag, BagCloud, BagCompression, BagWriter, TopicInfo, is_bag};
 pub use messages::PointCloud2;

@@ -1,0 +1,152 @@
+//! The messages of one MCAP file in the order they were written, from the `mcap` crate's sans-io
+//! reader with a bound on every record's length.
+//!
+//! `mcap::MessageStream` (0.26) reads chunk records without such a bound: a corrupted length in a
+//! damaged file makes it reserve exabytes and abort the process. Here every record (and so every
+//! allocation) is limited to [`MAX_RECORD_BYTES`], and a larger one is refused as corrupt.
+
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use mcap::records::Record;
+use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
+
+/// The largest record read (1 GiB): far above any point cloud (an OS1-128 at 2048 columns with
+/// every driver field is 12.6 MB), far below what a corrupted length asks for.
+pub const MAX_RECORD_BYTES: usize = 1 << 30;
+
+/// A channel as the stream knows it.
+#[derive(Debug)]
+pub struct ChannelInfo {
+    /// Its topic.
+    pub topic: String,
+    /// Its schema's name (empty where it has none).
+    pub schema: String,
+    /// Its message encoding (`cdr` for ROS 2).
+    pub message_encoding: String,
+    /// Its metadata.
+    pub metadata: std::collections::BTreeMap<String, String>,
+}
+
+/// A message of the stream.
+pub struct StreamMessage<'a> {
+    /// Its channel.
+    pub channel: Arc<ChannelInfo>,
+    /// Its log time, nanoseconds.
+    pub log_time_ns: u64,
+    /// Its bytes (borrowed from the file where its chunk was stored uncompressed).
+    pub data: Cow<'a, [u8]>,
+}
+
+/// Iterates the messages of an MCAP file's bytes (see the module docs).
+pub struct Messages<'a> {
+    buf: &'a [u8],
+    reader: LinearReader,
+    schemas: HashMap<u16, String>,
+    channels: HashMap<u16, Arc<ChannelInfo>>,
+    done: bool,
+}
+
+impl<'a> Messages<'a> {
+    /// Starts reading `buf`, a whole MCAP file.
+    pub fn new(buf: &'a [u8]) -> Self {
+        let options = LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES);
+        Self {
+            buf,
+            reader: LinearReader::new_with_options(options),
+            schemas: HashMap::new(),
+            channels: HashMap::new(),
+            done: false,
+        }
+    }
+
+    fn next_record(&mut self) -> Option<Result<Record<'a>, String>> {
+        while let Some(event) = self.reader.next_event() {
+            match event {
+                Ok(LinearReadEvent::ReadRequest(need)) => {
+                    let n = need.min(self.buf.len());
+                    self.reader.insert(n).copy_from_slice(&self.buf[..n]);
+                    self.reader.notify_read(n);
+                    self.buf = &self.buf[n..];
+                }
+                Ok(LinearReadEvent::Record { data, opcode }) => {
+                    return Some(mcap::parse_record(opcode, data).map(Record::into_owned).map_err(|e| e.to_string()));
+                }
+                Err(e) => return Some(Err(e.to_string())),
+            }
+        }
+        None
+    }
+}
+
+impl<'a> Iterator for Messages<'a> {
+    type Item = Result<StreamMessage<'a>, String>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        loop {
+            let record = match self.next_record() {
+                None => {
+                    self.done = true;
+                    return None;
+                }
+                Some(Err(e)) => {
+                    self.done = true;
+                    return Some(Err(e));
+                }
+                Some(Ok(r)) => r,
+            };
+            match record {
+                Record::Schema { header, .. } => {
+                    self.schemas.insert(header.id, header.name);
+                }
+                Record::Channel(c) => {
+                    let schema = if c.schema_id == 0 {
+                        String::new()
+                    } else {
+                        match self.schemas.get(&c.schema_id) {
+                            Some(name) => name.clone(),
+                            None => {
+                                self.done = true;
+                                return Some(Err(format!(
+                                    "channel {} names schema {}, which is not there",
+                                    c.id, c.schema_id
+                                )));
+                            }
+                        }
+                    };
+                    let info = ChannelInfo {
+                        topic: c.topic,
+                        schema,
+                        message_encoding: c.message_encoding,
+                        metadata: c.metadata,
+                    };
+                    self.channels.insert(c.id, Arc::new(info));
+                }
+                Record::Message { header, data } => {
+                    let Some(channel) = self.channels.get(&header.channel_id) else {
+                        self.done = true;
+                        return Some(Err(format!("a message on channel {}, which is not there", header.channel_id)));
+                    };
+                    return Some(Ok(StreamMessage { channel: channel.clone(), log_time_ns: header.log_time, data }));
+                }
+                // The summary after it repeats schemas and channels: the messages end here.
+                Record::DataEnd(_) => {
+                    // Read on to the end so that a truncated summary or end magic is reported.
+                    while let Some(r) = self.next_record() {
+                        if let Err(e) = r {
+                            self.done = true;
+                            return Some(Err(e));
+                        }
+                    }
+                    self.done = true;
+                    return None;
+                }
+                _ => {}
+            }
+        }
+    }
+}
