@@ -7,6 +7,8 @@ mod bench_raycast;
 /// Subcommands of `groundtruth bench`.
 #[derive(clap::Subcommand, Debug)]
 pub enum Command {
+    /// Two backends' scans compared cell by cell, and the GPU agreement contract checked.
+    Agreement(super::bench_agreement::Args),
     /// Ground classification speed (ms per frame).
     Classify(super::bench_classify::Args),
     /// Ray casting speed (rays per second) of a caster backend on a scene or mesh.
@@ -18,6 +20,7 @@ pub enum Command {
 /// Runs `groundtruth bench`.
 pub fn run(c: Command) -> anyhow::Result<()> {
     match c {
+        Command::Agreement(a) => super::bench_agreement::run(a),
         Command::Classify(a) => super::bench_classify::run(a),
         Command::Raycast(a) => bench_raycast::run(a),
         Command::Scan(a) => super::bench_scan::run(a),

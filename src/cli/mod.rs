@@ -1,6 +1,7 @@
 //! Command-line interface: one module per subcommand.
 
 mod bench;
+mod bench_agreement;
 mod bench_classify;
 mod bench_scan;
 mod classify;

@@ -125,7 +125,6 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
 
     let single = rig.sensors.len() == 1;
     let sensor_from_vehicle = single.then(|| rig.sensors[0].mount.vehicle_from_sensor().inverse());
-    let mut frames = Vec::with_capacity(args.frames);
     // The bag: every frame's clouds, its pose and the mounts (sim::io::ros2::scan).
     let sensor_topics = sim::io::ros2::scan::sensor_topics(&rig);
     let mut bag = match formats.mcap {
@@ -137,41 +136,58 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         }
         false => None,
     };
-    for k in 0..args.frames {
-        let frame = scanner.frame(k);
-        let ctx = FrameContext { index: k, sensor_from_vehicle };
-        let mut files = sim::io::formats::write_frame(&args.out, &frame.cloud, &ctx, &formats)?;
-        if let Some(b) = bag.as_mut() {
-            let written = sim::io::ros2::scan::write_frame(
-                b,
-                &frame.cloud,
-                &sensor_topics,
-                formats.pcd_layout,
-                frame.start_time_s,
-                &frame.world_from_vehicle,
-            )?;
-            for (topic, points) in written {
-                files.push(sim::io::formats::WrittenFile {
-                    file: format!("{BAG_DIR}/{BAG_DIR}_0.mcap"),
-                    format: format!("mcap:{topic}"),
-                    points,
+    // A pipeline: this thread casts frame k + 1 (on the rayon pool) while a writer thread encodes
+    // and writes frame k; the files and their order do not depend on the timing.
+    let frames = std::thread::scope(|scope| -> anyhow::Result<Vec<FrameEntry>> {
+        let (sender, receiver) = std::sync::mpsc::sync_channel::<sim::scan::Frame>(1);
+        let (out, formats, topics, bag) = (&args.out, &formats, &sensor_topics, &mut bag);
+        let writer = scope.spawn(move || -> anyhow::Result<Vec<FrameEntry>> {
+            let mut entries = Vec::new();
+            for frame in receiver {
+                let ctx = FrameContext { index: frame.index, sensor_from_vehicle };
+                let mut files = sim::io::formats::write_frame(out, &frame.cloud, &ctx, formats)?;
+                if let Some(b) = bag.as_mut() {
+                    let written = sim::io::ros2::scan::write_frame(
+                        b,
+                        &frame.cloud,
+                        topics,
+                        formats.pcd_layout,
+                        frame.start_time_s,
+                        &frame.world_from_vehicle,
+                    )?;
+                    for (topic, points) in written {
+                        files.push(sim::io::formats::WrittenFile {
+                            file: format!("{BAG_DIR}/{BAG_DIR}_0.mcap"),
+                            format: format!("mcap:{topic}"),
+                            points,
+                        });
+                    }
+                }
+                let file = files.first().map(|f| f.file.clone()).unwrap_or_default();
+                entries.push(FrameEntry {
+                    index: frame.index,
+                    file,
+                    rows: frame.cloud.rows * frame.cloud.planes,
+                    cols: frame.cloud.cols,
+                    returns: frame.cloud.returns(),
+                    ground_returns: frame.cloud.ground_returns(),
+                    start_time_s: frame.start_time_s,
+                    vehicle_pose: frame.vehicle_pose,
+                    world_from_vehicle: matrix_rows(&frame.world_from_vehicle),
+                    files,
                 });
             }
-        }
-        let file = files.first().map(|f| f.file.clone()).unwrap_or_default();
-        frames.push(FrameEntry {
-            index: k,
-            file,
-            rows: frame.cloud.rows * frame.cloud.planes,
-            cols: frame.cloud.cols,
-            returns: frame.cloud.returns(),
-            ground_returns: frame.cloud.ground_returns(),
-            start_time_s: frame.start_time_s,
-            vehicle_pose: frame.vehicle_pose,
-            world_from_vehicle: matrix_rows(&frame.world_from_vehicle),
-            files,
+            Ok(entries)
         });
-    }
+        for k in 0..args.frames {
+            // A failed writer has dropped the receiver: stop casting and report its error.
+            if sender.send(scanner.frame(k)).is_err() {
+                break;
+            }
+        }
+        drop(sender);
+        writer.join().map_err(|_| anyhow::anyhow!("the writer thread panicked"))?
+    })?;
     if let Some(b) = bag {
         b.finish()?;
     }

@@ -16,9 +16,11 @@
 //!   (per-laser offsets): the interval test covers them. Groups whose directions straddle an axis
 //!   are cast one ray at a time. Optionally ([`BvhOptions::coherent`], off by default: measured no gain)
 //!   the triangle the previous ray hit is tested first to seed a short `t_max`.
-//! - Every ray gets the same closest hit as [`Caster::cast`] (ties between triangles at exactly the
-//!   same distance may pick the other triangle; a tie is not a leak), and the grouping depends only
-//!   on the batch, so results never depend on the thread count.
+//! - Every ray gets the same closest hit as [`Caster::cast`], and the grouping depends only on the
+//!   batch, so results never depend on the thread count. Of triangles at exactly the same distance
+//!   (a shared edge, coplanar overlapping faces) the 4-wide tree reports the lowest mesh index, as
+//!   the GPU backend does; the obvhs trees of [`BvhOptions`] may report another (a tie is not a
+//!   leak).
 
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -160,7 +162,7 @@ impl BvhCaster {
         };
         if let Tree::Four(mut w) = tree {
             let tris = std::mem::take(&mut w.tris);
-            let order = std::mem::take(&mut w.order_to_triangle);
+            let order = w.order_to_triangle.clone(); // Also kept in the tree: its tie-break reads it.
             return Self { tree: Tree::Four(w), tris, order_to_triangle: order, options, pad_m };
         }
         let tris = indices.iter().map(|&i| mesh.triangle(i as usize)).collect();

@@ -133,7 +133,7 @@ impl Wide4 {
         let mut best = seed;
         let mut best_t = seed.map_or(pre.t_max, |s| s.1);
         if let Some((first, count)) = self.root_leaf {
-            Self::leaf(tris, pre, first, count, &mut best, &mut best_t);
+            Self::leaf(tris, &self.order_to_triangle, pre, first, count, &mut best, &mut best_t);
             return best;
         }
         if self.nodes.is_empty() {
@@ -175,7 +175,7 @@ impl Wide4 {
                     inner[q] = (n.child[k], t);
                     q += 1;
                 } else if t <= best_t {
-                    Self::leaf(tris, pre, n.child[k], n.count[k], &mut best, &mut best_t);
+                    Self::leaf(tris, &self.order_to_triangle, pre, n.child[k], n.count[k], &mut best, &mut best_t);
                 }
             }
             // Descend into the nearest inner child; push the others farthest first.
@@ -186,15 +186,32 @@ impl Wide4 {
         }
     }
 
+    /// The closest hit among a leaf's triangles; of triangles at exactly the same distance (a
+    /// shared edge, coplanar overlapping faces), the one with the lowest mesh index, so that every
+    /// layout of the tree and the GPU backend report the same triangle (and label).
     #[inline(always)]
-    fn leaf(tris: &[[Vec3; 3]], pre: &RayPre, first: u32, count: u32, best: &mut Option<(u32, f32)>, best_t: &mut f32) {
+    #[allow(clippy::too_many_arguments)]
+    fn leaf(
+        tris: &[[Vec3; 3]],
+        ids: &[u32],
+        pre: &RayPre,
+        first: u32,
+        count: u32,
+        best: &mut Option<(u32, f32)>,
+        best_t: &mut f32,
+    ) {
         for i in first..first + count {
             let [a, b, c] = tris[i as usize];
-            if let Some(t) = pre.intersect(a, b, c, *best_t)
-                && (best.is_none() || t < *best_t)
-            {
-                *best = Some((i, t));
-                *best_t = t;
+            // `intersect` keeps `t <= best_t`: a tie is `t == best_t`.
+            if let Some(t) = pre.intersect(a, b, c, *best_t) {
+                let better = match *best {
+                    None => true,
+                    Some((j, bt)) => t < bt || ids[i as usize] < ids[j as usize],
+                };
+                if better {
+                    *best = Some((i, t));
+                    *best_t = t;
+                }
             }
         }
     }
@@ -323,7 +340,8 @@ impl Wide4 {
                         leaf_hits.get_or_insert_with(|| std::array::from_fn(|r| slab4(n, &rbs[r], best_t[r]).1));
                     for r in 0..N {
                         if per_ray[r][k] {
-                            Self::leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
+                            let ids = &self.order_to_triangle;
+                            Self::leaf(tris, ids, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
                         }
                     }
                     far_t = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));

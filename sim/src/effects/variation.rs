@@ -18,6 +18,7 @@ use crate::scene::SemanticClass;
 /// ```
 /// let mut cloud = sim::OrderedCloud::empty(1, 1000, 1);
 /// for p in cloud.point_in_vehicle.iter_mut() { *p = glam::Vec3::X; }
+/// cloud.range_m.fill(1.0);
 /// for (c, col) in cloud.column.iter_mut().enumerate() { *col = c as u32; }
 /// cloud.sensor.fill(0);
 /// let removed = sim::effects::variation::drop_returns(&mut cloud, 0.1, 7, 0).unwrap();

@@ -32,10 +32,12 @@ use crate::rig::Rig;
 use crate::scene::{SceneMesh, Surface};
 use crate::sensor::{Measurement, ScanPattern};
 
+mod agreement;
 mod cells;
 mod rays;
 mod row;
 
+pub use agreement::{Agreement, AgreementContract};
 use cells::{ExtraEcho, row_views};
 pub use rays::RowRays;
 use rays::{RowBeams, ShotTimes};

@@ -59,6 +59,10 @@ pub struct Args {
     /// Allow more than 10 million frames in all.
     #[arg(long)]
     pub allow_large: bool,
+    /// Ray casting backend: `bvh` (the reproducible reference) or `gpu` (files agree with `bvh`'s
+    /// within the contract of docs/scanning.md, not to the bit).
+    #[arg(long, default_value = "bvh")]
+    pub backend: String,
 }
 
 /// The subcommands of `groundtruth dataset`.
@@ -90,7 +94,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let shard = crate::cli::shard::Shard::parse(&args.shard)?;
     let config = config::DatasetConfig::load(config, args.allow_large)?;
-    let summary = super::scan::with_threads(args.threads, || write::generate(&config, out, shard, args.resume))??;
+    let backend = super::scan::parse_backend(&args.backend)?;
+    let summary =
+        super::scan::with_threads(args.threads, || write::generate(&config, out, shard, args.resume, backend))??;
     println!("{}", serde_json::to_string_pretty(&summary)?);
     Ok(())
 }

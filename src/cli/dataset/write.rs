@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use glam::{DAffine3, DQuat, EulerRot};
+use rayon::prelude::*;
 use sim::io::atomic::write_bytes_atomic;
 use sim::motion::{Trajectory, VehiclePose};
 use sim::scan::{ScanConfig, Scanner};
@@ -134,6 +135,8 @@ fn manifest(config: &DatasetConfig, prepared: &[Prepared]) -> anyhow::Result<ser
         "name": config.name,
         "label_config": LABEL_CONFIG,
         "frames": config.sequences.iter().map(|s| s.frames).sum::<u64>(),
+        // `bvh` (the reproducible reference) or `gpu` (within the agreement contract).
+        "backend": prepared.first().map_or("bvh", |p| p.scan.backend.name()),
         "config": config,
         "sequences": sequences,
     }))
@@ -212,7 +215,13 @@ fn peak_rss_mb() -> f64 {
 pub const BAG_DIR: &str = "bag";
 
 /// Checks everything, claims `out` and writes this shard's frames.
-pub fn generate(config: &DatasetConfig, out: &Path, shard: Shard, resume: bool) -> anyhow::Result<Summary> {
+pub fn generate(
+    config: &DatasetConfig,
+    out: &Path,
+    shard: Shard,
+    resume: bool,
+    backend: sim::cast::Backend,
+) -> anyhow::Result<Summary> {
     let t0 = Instant::now();
     if shard != Shard::ALL
         && let Some(s) = config.sequences.iter().find(|s| s.formats.iter().any(|f| f == "mcap"))
@@ -222,7 +231,10 @@ pub fn generate(config: &DatasetConfig, out: &Path, shard: Shard, resume: bool) 
             s.id
         );
     }
-    let prepared = prepare(config)?;
+    let mut prepared = prepare(config)?;
+    for p in &mut prepared {
+        p.scan.backend = backend;
+    }
     let manifest = manifest(config, &prepared)?;
     claim(out, &manifest, &super::labels::yaml(&config.split_or_default()))?;
     let mut summary = Summary {
@@ -236,10 +248,26 @@ pub fn generate(config: &DatasetConfig, out: &Path, shard: Shard, resume: bool) 
         frames_per_s: 0.0,
         peak_rss_mb: 0.0,
     };
-    let mut first = 0u64;
-    for p in &prepared {
-        write_sequence(p, out, shard, first, resume, &mut summary)?;
-        first += p.config.frames;
+    // Sequences, and the frames within each, run in parallel (rayon): a run waits on no serial
+    // part but the claim and the manifest. Every frame's files are the same bytes in any order.
+    let firsts: Vec<u64> = prepared
+        .iter()
+        .scan(0u64, |first, p| {
+            let f = *first;
+            *first += p.config.frames;
+            Some(f)
+        })
+        .collect();
+    let counts = prepared
+        .par_iter()
+        .zip(firsts.par_iter())
+        .map(|(p, &first)| write_sequence(p, out, shard, first, resume))
+        .collect::<anyhow::Result<Vec<Counts>>>()?;
+    for c in counts {
+        summary.frames_in_shard += c.in_shard;
+        summary.frames_written += c.written;
+        summary.frames_skipped += c.skipped;
+        summary.points_written += c.points;
     }
     summary.seconds = t0.elapsed().as_secs_f64();
     summary.frames_per_s = summary.frames_written as f64 / summary.seconds.max(1e-9);
@@ -249,14 +277,7 @@ pub fn generate(config: &DatasetConfig, out: &Path, shard: Shard, resume: bool) 
 
 /// Writes one sequence's text files and this shard's frames of it (`first`: the global number of
 /// its frame 0).
-fn write_sequence(
-    p: &Prepared,
-    out: &Path,
-    shard: Shard,
-    first: u64,
-    resume: bool,
-    summary: &mut Summary,
-) -> anyhow::Result<()> {
+fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bool) -> anyhow::Result<Counts> {
     let s = &p.config;
     let seq = out.join("sequences").join(format!("{:02}", s.id));
     let scene = crate::cli::common::load_scene_full(&s.scene, s.seed)?;
@@ -293,49 +314,74 @@ fn write_sequence(
         }
         false => None,
     };
-    for k in 0..frames {
-        if !shard.contains(first + k as u64) {
-            continue;
-        }
-        summary.frames_in_shard += 1;
+    let write_frame = |k: usize, frame: &sim::scan::Frame| -> anyhow::Result<u64> {
         let stem = format!("{k:06}");
-        let bin = seq.join("velodyne").join(format!("{stem}.bin"));
-        let label = seq.join("labels").join(format!("{stem}.label"));
-        if resume && bag.is_none() && label.is_file() && bin.is_file() {
-            summary.frames_skipped += 1;
-            continue;
-        }
-        let mut frame = scanner.frame(k);
-        vary(&mut frame.cloud, s, k)?;
         let (bin_bytes, label_bytes, n) = sim::io::kitti::encode(&frame.cloud, cloud_from_vehicle.as_ref())?;
-        write_bytes_atomic(&bin, &bin_bytes)?;
-        for f in &s.formats {
+        write_bytes_atomic(&seq.join("velodyne").join(format!("{stem}.bin")), &bin_bytes)?;
+        for f in s.formats.iter().filter(|f| *f != "mcap") {
             let path = seq.join(f).join(format!("{stem}.{f}"));
             match f.as_str() {
                 "pcd" => sim::io::pcd::write(&path, &frame.cloud, false).map(|_| ())?,
                 "ply" => sim::io::ply::write(&path, &frame.cloud).map(|_| ())?,
-                "las" => sim::io::las::write_with(&path, &frame.cloud, false).map(|_| ())?,
-                _ => {
-                    if let Some(b) = bag.as_mut() {
-                        sim::io::ros2::scan::write_frame(
-                            b,
-                            &frame.cloud,
-                            &topics,
-                            sim::io::pcd::PcdLayout::Groundtruth,
-                            frame.start_time_s,
-                            &frame.world_from_vehicle,
-                        )?;
-                    }
-                }
+                _ => sim::io::las::write_with(&path, &frame.cloud, false).map(|_| ())?,
             }
         }
         // Last: the frame is complete once its `.label` exists.
-        write_bytes_atomic(&label, &label_bytes)?;
-        summary.frames_written += 1;
-        summary.points_written += n as u64;
+        write_bytes_atomic(&seq.join("labels").join(format!("{stem}.label")), &label_bytes)?;
+        Ok(n as u64)
+    };
+    let scan_frame = |k: usize| -> anyhow::Result<sim::scan::Frame> {
+        let mut frame = scanner.frame(k);
+        vary(&mut frame.cloud, s, k)?;
+        Ok(frame)
+    };
+    let mine: Vec<usize> = (0..frames).filter(|&k| shard.contains(first + k as u64)).collect();
+    let done = |k: usize| {
+        let stem = format!("{k:06}");
+        seq.join("labels").join(format!("{stem}.label")).is_file()
+            && seq.join("velodyne").join(format!("{stem}.bin")).is_file()
+    };
+    let mut counts = Counts { in_shard: mine.len() as u64, ..Counts::default() };
+    match bag.as_mut() {
+        // Frames in parallel, each written as it is made.
+        None => {
+            let todo: Vec<usize> = mine.iter().copied().filter(|&k| !(resume && done(k))).collect();
+            counts.skipped = (mine.len() - todo.len()) as u64;
+            let points =
+                todo.par_iter().map(|&k| write_frame(k, &scan_frame(k)?)).collect::<anyhow::Result<Vec<u64>>>()?;
+            counts.written = points.len() as u64;
+            counts.points = points.iter().sum();
+        }
+        // The bag takes the frames in order: cast in parallel a batch at a time, then write.
+        Some(b) => {
+            for batch in mine.chunks(rayon::current_num_threads().max(1) * 2) {
+                let made = batch.par_iter().map(|&k| scan_frame(k)).collect::<anyhow::Result<Vec<_>>>()?;
+                for (&k, frame) in batch.iter().zip(&made) {
+                    counts.points += write_frame(k, frame)?;
+                    counts.written += 1;
+                    sim::io::ros2::scan::write_frame(
+                        b,
+                        &frame.cloud,
+                        &topics,
+                        sim::io::pcd::PcdLayout::Groundtruth,
+                        frame.start_time_s,
+                        &frame.world_from_vehicle,
+                    )?;
+                }
+            }
+        }
     }
     if let Some(b) = bag {
         b.finish()?;
     }
-    Ok(())
+    Ok(counts)
+}
+
+/// What one sequence's run did.
+#[derive(Default)]
+struct Counts {
+    in_shard: u64,
+    written: u64,
+    skipped: u64,
+    points: u64,
 }

@@ -66,9 +66,10 @@ pub fn run(space: &Space, out: &Path, shard: Shard, resume: bool, threads: usize
     let todo = in_shard.saturating_sub(already_done);
     let progress = Progress::new(todo, &format!("sweep {shard}"));
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("starting the worker threads")?;
-    let mut prepared_count = 0;
-    let mut prepare_s = 0.0;
-    let mut ran = 0u64;
+    // The groups (scene, seed) with work for this shard, in order; each one's configurations run
+    // in parallel, and the next group's scene is prepared (built, its BVH made) while they run, so
+    // no core waits on a preparation.
+    let mut groups = Vec::new();
     for group in 0..space.groups() {
         let lo = group * space.group_size;
         let hi = lo + space.group_size;
@@ -78,35 +79,55 @@ pub fn run(space: &Space, out: &Path, shard: Shard, resume: bool, threads: usize
             continue;
         }
         let n = (hi - first).div_ceil(shard.count);
-        let pending = |j: u64| {
+        let has_pending = (0..n).any(|j| !done.contains(&space.key(&space.decode(first + j * shard.count))));
+        if has_pending {
+            groups.push((lo, first, n));
+        }
+    }
+    let prepare = |lo: u64| -> anyhow::Result<(crate::cli::common::LoadedScene, PreparedScene, f64)> {
+        let t = Instant::now();
+        let c0 = space.decode(lo);
+        let (scene_name, seed) = (&space.sweep.scenes[c0.scene], space.sweep.seeds[c0.seed]);
+        let scene = crate::cli::common::load_scene_full(scene_name, seed)
+            .with_context(|| format!("scene `{scene_name}` seed {seed}"))?;
+        let prepared = PreparedScene::new(&scene.mesh, sim::cast::Backend::Bvh)?;
+        Ok((scene, prepared, t.elapsed().as_secs_f64()))
+    };
+    // Groups go in batches of (at least) as many as there are threads: a batch's configurations
+    // form one parallel loop (no core idles at the end of each group), and the next batch is
+    // prepared while it runs.
+    let batch = threads.max(2);
+    let batches: Vec<&[(u64, u64, u64)]> = groups.chunks(batch).collect();
+    let prepare_batch =
+        |b: &[(u64, u64, u64)]| -> anyhow::Result<Vec<_>> { b.par_iter().map(|&(lo, _, _)| prepare(lo)).collect() };
+    let mut prepare_s = 0.0;
+    let mut ran = 0u64;
+    let mut next = match batches.first() {
+        Some(b) => Some(pool.install(|| prepare_batch(b))?),
+        None => None,
+    };
+    for (k, b) in batches.iter().enumerate() {
+        let scenes = next.take().expect("prepared ahead");
+        prepare_s += scenes.iter().map(|s| s.2).sum::<f64>();
+        // Every pending configuration of the batch: (its group's place in the batch, j).
+        let work: Vec<(usize, u64)> =
+            b.iter().enumerate().flat_map(|(g, &(_, _, n))| (0..n).map(move |j| (g, j))).collect();
+        let pending = |&(g, j): &(usize, u64)| {
+            let (_, first, _) = b[g];
             let index = first + j * shard.count;
             debug_assert!(shard.contains(index));
             let c = space.decode(index);
             let key = space.key(&c);
-            (!done.contains(&key)).then_some((c, key))
+            (!done.contains(&key)).then_some((g, c, key))
         };
-        if !(0..n).any(|j| pending(j).is_some()) {
-            continue;
-        }
-        let c0 = space.decode(lo);
-        let (scene_name, seed) = (&space.sweep.scenes[c0.scene], space.sweep.seeds[c0.seed]);
-        let t = Instant::now();
-        let (scene, prepared) = pool.install(|| -> anyhow::Result<_> {
-            let scene = crate::cli::common::load_scene_full(scene_name, seed)
-                .with_context(|| format!("scene `{scene_name}` seed {seed}"))?;
-            let prepared = PreparedScene::new(&scene.mesh, sim::cast::Backend::Bvh)?;
-            Ok((scene, prepared))
-        })?;
-        prepare_s += t.elapsed().as_secs_f64();
-        prepared_count += 1;
-        let ran_here = pool.install(|| {
-            (0..n)
-                .into_par_iter()
+        let evaluate_batch = || {
+            work.par_iter()
                 .filter_map(pending)
                 .try_fold(
                     || (sim::OrderedCloud::default(), 0u64),
-                    |(mut cloud, count), (c, key)| -> anyhow::Result<_> {
-                        let rows = super::evaluate::evaluate(space, &c, &key, &scene, &prepared, &mut cloud)
+                    |(mut cloud, count), (g, c, key)| -> anyhow::Result<_> {
+                        let (scene, prepared, _) = &scenes[g];
+                        let rows = super::evaluate::evaluate(space, &c, &key, scene, prepared, &mut cloud)
                             .with_context(|| format!("configuration {} (key {key})", c.index))?;
                         let mut csv_text = String::new();
                         let mut json_text = String::new();
@@ -127,9 +148,14 @@ pub fn run(space: &Space, out: &Path, shard: Shard, resume: bool, threads: usize
                 )
                 .map(|r| r.map(|(_, count)| count))
                 .try_reduce(|| 0, |a, b| Ok(a + b))
-        })?;
-        ran += ran_here;
+        };
+        let following = batches.get(k + 1).copied();
+        let (ran_here, prepared_next) =
+            pool.install(|| rayon::join(evaluate_batch, || following.map(prepare_batch).transpose()));
+        ran += ran_here?;
+        next = prepared_next?;
     }
+    let prepared_count = groups.len() as u64;
     progress.finish();
     let (mut csv, mut jsonl) = logs.into_inner().unwrap_or_else(|e| e.into_inner());
     csv.sync()?;

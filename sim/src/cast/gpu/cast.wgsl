@@ -63,6 +63,25 @@ fn corner(p: u32, k: u32) -> vec3<f32> {
     }
 }
 
+// Mesh index of leaf-order triangle `p` (its first corner's fourth float).
+fn triangle_id(p: u32) -> u32 {
+    let j = 3u * (p & ((1u << TRI_SHIFT) - 1u));
+    switch (p >> TRI_SHIFT) {
+        case 0u: {
+            return bitcast<u32>(tris0[j].w);
+        }
+        case 1u: {
+            return bitcast<u32>(tris1[j].w);
+        }
+        case 2u: {
+            return bitcast<u32>(tris2[j].w);
+        }
+        default: {
+            return bitcast<u32>(tris3[j].w);
+        }
+    }
+}
+
 const STACK: u32 = 64u;
 const MISS: u32 = 0xFFFFFFFFu;
 const OVERFLOW: u32 = 0xFFFFFFFEu;
@@ -199,7 +218,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let t = ts / det;
-            if (t > 0.0 && t <= t_best) {
+            // The closest; at exactly the same distance, the lowest mesh index (as on the CPU).
+            if (t > 0.0 && (t < t_best || (t == t_best && (hit == MISS || triangle_id(p) < triangle_id(hit))))) {
                 t_best = t;
                 hit = p;
             }

@@ -66,9 +66,11 @@ impl SceneBuffers {
             }
             order_to_triangle = bvh2.primitive_indices.clone();
             tris.reserve(order_to_triangle.len() * 12);
+            // Each corner's fourth float: the triangle's mesh index (bits), for the shader's
+            // tie-break between triangles at exactly the same distance.
             for &i in &order_to_triangle {
                 for p in mesh.triangle(i as usize) {
-                    tris.extend_from_slice(&[p.x, p.y, p.z, 0.0]);
+                    tris.extend_from_slice(&[p.x, p.y, p.z, f32::from_bits(i)]);
                 }
             }
         }

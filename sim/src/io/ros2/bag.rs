@@ -635,4 +635,47 @@ mod tests {
         drop(w);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
+
+    /// A bag from another writer: lz4 chunks (Foxglove's tools and some converters write them),
+    /// no summary section, no `metadata.yaml`, two messages per chunk; and a sqlite3 rosbag2
+    /// directory, refused by name.
+    #[test]
+    fn lz4_chunks_without_a_summary_and_sqlite3_bags() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("other.mcap");
+        let file = BufWriter::new(std::fs::File::create(&path).unwrap());
+        let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Lz4))
+            .chunk_size(Some(64))
+            .emit_summary_records(false)
+            .emit_summary_offsets(false);
+        let mut w = options.create(file).unwrap();
+        let schema = w.add_schema(POINTCLOUD2, "ros2msg", pointcloud2_definition().as_bytes()).unwrap();
+        let channel = w.add_channel(schema, "/points", "cdr", &BTreeMap::new()).unwrap();
+        for k in 0..4u8 {
+            let header =
+                mcap::records::MessageHeader { channel_id: channel, sequence: 0, log_time: 0, publish_time: 0 };
+            w.write_to_known_channel(&header, &to_cdr(&cloud(k), 12).unwrap()).unwrap();
+        }
+        w.finish().unwrap();
+        drop(w);
+        let b = Bag::open(&path).unwrap();
+        assert_eq!(b.pointcloud_topics().unwrap()[0].count, 4);
+        let mut z = Vec::new();
+        b.for_each_cloud("/points", |c| {
+            z.push(f32::from_le_bytes(c.decode().unwrap().data[8..12].try_into().unwrap()));
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(z, [3.0, 4.0, 5.0, 6.0]);
+        let sqlite = dir.path().join("sqlite");
+        std::fs::create_dir(&sqlite).unwrap();
+        std::fs::write(
+            sqlite.join("metadata.yaml"),
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  relative_file_paths:\n    - sqlite_0.db3\n",
+        )
+        .unwrap();
+        let e = Bag::open(&sqlite).unwrap_err().to_string();
+        assert!(e.contains("sqlite3") && e.contains("ros2 bag convert"), "{e}");
+    }
 }

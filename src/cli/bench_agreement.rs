@@ -1,0 +1,105 @@
+//! `groundtruth bench agreement`: scans the same scene, rig, seed and frames with two backends
+//! (default `gpu` against the reference `bvh`), compares them cell by cell and checks the GPU
+//! contract ([`sim::scan::AgreementContract::GPU`]). Prints one JSON object; exits non-zero when
+//! the contract is broken.
+
+use std::time::Instant;
+
+use sim::scan::{Agreement, AgreementContract, ScanConfig, Scanner};
+
+/// Arguments of `groundtruth bench agreement`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene name or TOML file.
+    #[arg(long, default_value = "city")]
+    pub scene: String,
+    /// Rig preset or TOML file.
+    #[arg(long, default_value = "hdl64e-roof")]
+    pub rig: String,
+    /// Frames to compare.
+    #[arg(long, default_value_t = 3)]
+    pub frames: usize,
+    /// Seed of the scene and of the measurement noise.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Ego speed, metres per second (0: a standing vehicle, whose rays stay on the device).
+    #[arg(long, default_value_t = 10.0)]
+    pub speed: f32,
+    /// Measurement effects off (exact distances).
+    #[arg(long)]
+    pub ideal: bool,
+    /// The backend under test.
+    #[arg(long, default_value = "gpu")]
+    pub backend: String,
+    /// The reference backend.
+    #[arg(long, default_value = "bvh")]
+    pub reference: String,
+}
+
+/// Runs the comparison.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if !(1..=1000).contains(&args.frames) {
+        anyhow::bail!("invalid value for `--frames`: {} (allowed: 1 ..= 1000)", args.frames);
+    }
+    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
+    let rig = super::common::load_rig(&args.rig)?;
+    let scan = |backend: &str| -> anyhow::Result<(Vec<sim::OrderedCloud>, f64)> {
+        let config = ScanConfig {
+            seed: args.seed,
+            frames: args.frames,
+            speed_m_per_s: args.speed,
+            ideal: args.ideal,
+            backend: super::scan::parse_backend(backend)?,
+            ego_z_m: scene.ego_ground_z_m,
+            ..ScanConfig::default()
+        };
+        let t0 = Instant::now();
+        let scanner = Scanner::new(&scene.mesh, &rig, config)?;
+        let clouds = (0..args.frames).map(|k| scanner.frame(k).cloud).collect();
+        Ok((clouds, t0.elapsed().as_secs_f64()))
+    };
+    let (tested, tested_s) = scan(&args.backend)?;
+    let (reference, reference_s) = scan(&args.reference)?;
+    let mut total = Agreement::default();
+    for (a, b) in tested.iter().zip(&reference) {
+        total.add(&Agreement::of(a, b)?);
+    }
+    // The coarsest range quantum of the rig's sensors (0 with --ideal).
+    let quantum = if args.ideal {
+        0.0
+    } else {
+        rig.sensors.iter().map(|s| s.spec.measurement().range_quantum_m).fold(0.0f32, f32::max)
+    };
+    let verdict = AgreementContract::GPU.check(&total, quantum);
+    let json = serde_json::json!({
+        "scene": args.scene,
+        "rig": args.rig,
+        "frames": args.frames,
+        "speed_m_per_s": args.speed,
+        "ideal": args.ideal,
+        "backend": args.backend,
+        "reference": args.reference,
+        "adapter": adapter(&args.backend),
+        "seconds": { "backend": tested_s, "reference": reference_s },
+        "agreement": total,
+        "hit_miss_share": total.hit_miss_share(),
+        "label_share": total.label_share(),
+        "bit_equal_share": total.bit_equal_share(),
+        "range_quantum_m": quantum,
+        "contract": { "holds": verdict.is_ok(), "broken": verdict.as_ref().err() },
+    });
+    println!("{}", serde_json::to_string_pretty(&json)?);
+    if let Err(e) = verdict {
+        anyhow::bail!("the {} backend breaks the agreement contract against {}: {e}", args.backend, args.reference);
+    }
+    Ok(())
+}
+
+fn adapter(backend: &str) -> Option<String> {
+    #[cfg(feature = "gpu")]
+    if backend == "gpu" {
+        return sim::cast::gpu::adapter_description().ok();
+    }
+    let _ = backend;
+    None
+}
