@@ -186,10 +186,13 @@ def scan(
     frames: int = 1,
     speed: float = 0.0,
     ideal: bool = False,
+    weather: Optional[str] = None,
 ) -> list[Frame]:
     """Scan ``scene`` (bundled name, family, ``.toml`` path or TOML text) with ``rig`` (preset,
     ``.toml`` path or TOML text). ``params``: family parameters; ``mount``: ``x_m y_m z_m roll_deg
-    pitch_deg yaw_deg`` (and ``sensor``); ``ideal``: exact ranges. Deterministic."""
+    pitch_deg yaw_deg`` (and ``sensor``); ``ideal``: exact ranges; ``weather``:
+    ``"fog:visibility_m=50"``, ``"rain:rate_mm_h=10"``, ``"snow:rate_mm_h=2"`` or ``"clear"``
+    (returns from the medium get labels 150 fog, 151 rain, 152 snow). Deterministic."""
 
 def regions(frame: Frame) -> dict[str, npt.NDArray[np.bool_]]:
     """Every region of the frame's scene, name -> ``(H, W)`` mask."""

@@ -36,6 +36,7 @@ fn scenario(
     frames: &Bound<'_, PyAny>,
     speed: &Bound<'_, PyAny>,
     ideal: bool,
+    weather: Option<&str>,
 ) -> PyResult<groundtruth_scenario::Scenario> {
     let mut s = with_rig(scene_scenario(scene)?, rig)?;
     if let Some(p) = params {
@@ -47,6 +48,9 @@ fn scenario(
     let speed = finite_f64(speed, "speed")?;
     if speed.abs() > 100.0 {
         return Err(value_error("speed", format!("{speed} m/s is out of range (allowed: -100 ..= 100)")));
+    }
+    if let Some(spec) = weather {
+        s = s.weather(sim::effects::weather::Weather::parse(spec).map_err(crate::error::sim_error)?);
     }
     Ok(s.seed(uint(seed, "seed", 0, u64::MAX)?)
         .frames(uint(frames, "frames", 1, MAX_FRAMES)? as usize)
@@ -62,12 +66,14 @@ fn scenario(
 /// (`{"slope_deg": -12.0}`), range-checked. `mount`: overrides of the sensor's mount (`x_m y_m z_m
 /// roll_deg pitch_deg yaw_deg`, and `sensor` = which sensor, default 0). `seed`: the scene
 /// generator's and the scan's seed. `frames`: frame count; `speed`: ego speed, m/s. `ideal`: exact
-/// ranges, measurement effects off. Deterministic: the same arguments give the same arrays. The
+/// ranges, measurement effects off. `weather`: `"fog:visibility_m=50"`, `"rain:rate_mm_h=10"`,
+/// `"snow:rate_mm_h=2"` or `"clear"` (default: the scene file's `[weather]`, else none); returns
+/// from the medium are labelled fog (150), rain (151) or snow (152). Deterministic: the same arguments give the same arrays. The
 /// GIL is released while the scene is generated and scanned.
 #[pyfunction]
 #[pyo3(
-    signature = (scene, rig, *, params=None, mount=None, seed=None, frames=None, speed=None, ideal=false),
-    text_signature = "(scene, rig, *, params=None, mount=None, seed=0, frames=1, speed=0.0, ideal=False)"
+    signature = (scene, rig, *, params=None, mount=None, seed=None, frames=None, speed=None, ideal=false, weather=None),
+    text_signature = "(scene, rig, *, params=None, mount=None, seed=0, frames=1, speed=0.0, ideal=False, weather=None)"
 )]
 #[allow(clippy::too_many_arguments)]
 fn scan(
@@ -80,6 +86,7 @@ fn scan(
     frames: Option<&Bound<'_, PyAny>>,
     speed: Option<&Bound<'_, PyAny>>,
     ideal: bool,
+    weather: Option<&str>,
 ) -> PyResult<Vec<Frame>> {
     let zero = 0u64.into_pyobject(py)?.into_any();
     let one = 1u64.into_pyobject(py)?.into_any();
@@ -93,6 +100,7 @@ fn scan(
         frames.unwrap_or(&one),
         speed.unwrap_or(&zero_f),
         ideal,
+        weather,
     )?;
     let scan = Arc::new(py.detach(move || s.scan()).map_err(scenario_error)?);
     Ok((0..scan.frames().len()).map(|k| Frame { scan: scan.clone(), k }).collect())

@@ -60,6 +60,8 @@ pub struct Scenario {
     frames: usize,
     speed_m_per_s: f32,
     yaw_rate_rad_per_s: f32,
+    /// `None`: the scene file's `[weather]`, if any.
+    weather: Option<sim::effects::weather::Weather>,
 }
 
 impl Scenario {
@@ -75,6 +77,7 @@ impl Scenario {
             frames: 1,
             speed_m_per_s: 0.0,
             yaw_rate_rad_per_s: 0.0,
+            weather: None,
         }
     }
 
@@ -332,6 +335,26 @@ impl Scenario {
         self
     }
 
+    /// Weather decided per beam (fog by visibility, rain and snow by rate; see
+    /// [`sim::effects::weather`]), in place of the scene file's `[weather]` table. Returns from the
+    /// medium are labelled fog, rain or snow and are never ground. Refused at [`Scenario::scan`] when
+    /// out of range (visibility 1 ..= 100000 m, rain 0 ..= 200 mm/h, snow 0 ..= 20 mm/h).
+    ///
+    /// ```
+    /// use groundtruth_scenario::{Scenario, Weather};
+    /// let s = Scenario::family("flat").rig("hdl64e-roof").weather(Weather::Fog { visibility_m: 30.0 }).scan()?;
+    /// let c = &s.frames()[0].cloud;
+    /// let fog = (0..c.len()).filter(|&i| c.has_return(i) && c.label[i] == sim::scene::SemanticClass::FOG).count();
+    /// assert!(fog > 1000, "{fog} fog returns");
+    /// let err = Scenario::family("flat").weather(Weather::Fog { visibility_m: 0.5 }).scan().unwrap_err();
+    /// assert!(err.to_string().contains("visibility_m"), "{err}");
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn weather(mut self, weather: sim::effects::weather::Weather) -> Self {
+        self.weather = Some(weather);
+        self
+    }
+
     /// The scene's TOML text with the parameter overrides applied, and its base directory.
     fn scene_text(&self) -> Result<(String, String, PathBuf)> {
         let (text, name, base_dir) = match &self.source {
@@ -426,6 +449,7 @@ impl Scenario {
             yaw_rate_rad_per_s: self.yaw_rate_rad_per_s,
             ideal: self.ideal,
             ego_z_m: scene.ego_ground_z_m,
+            weather: self.weather.or(scene.weather),
             ..ScanConfig::default()
         };
         let frames = sim::scan::scan(&scene.mesh, &rig, &config)?;

@@ -48,3 +48,4 @@ pub use scan::{Decisions, Scan};
 pub use score::RegionScore;
 /// The simulator crate, re-exported (clouds, rigs, classes).
 pub use sim;
+pub use sim::effects::weather::Weather;

@@ -17,7 +17,7 @@ use std::ops::RangeInclusive;
 
 use proptest::prelude::*;
 
-use crate::{MountOverride, Scenario};
+use crate::{MountOverride, Scenario, Weather};
 
 /// A `ramp` scene: the corridor's slope (negative descends) and the distance to its foot.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -296,6 +296,42 @@ pub fn mount() -> impl Strategy<Value = MountCase> {
 /// ```
 pub fn noise() -> impl Strategy<Value = bool> {
     any::<bool>()
+}
+
+/// Weather drawn from the given ranges: fog of visibility `visibility_m`, rain and snow of rate
+/// `rain_mm_h` / `snow_mm_h` (within 1 ..= 100000 m, 0 ..= 200 mm/h and 0 ..= 20 mm/h), each kind
+/// equally likely; use as `scenario.weather(w)`.
+///
+/// ```
+/// use groundtruth_scenario::{Weather, strategies};
+/// use proptest::strategy::{Strategy, ValueTree};
+/// let mut runner = proptest::test_runner::TestRunner::deterministic();
+/// let w = strategies::weathers(30.0..=60.0, 5.0..=10.0, 1.0..=2.0).new_tree(&mut runner).unwrap().current();
+/// assert!(w.validate().is_ok(), "{w:?}");
+/// ```
+pub fn weathers(
+    visibility_m: RangeInclusive<f64>,
+    rain_mm_h: RangeInclusive<f64>,
+    snow_mm_h: RangeInclusive<f64>,
+) -> impl Strategy<Value = Weather> {
+    prop_oneof![
+        visibility_m.prop_map(|visibility_m| Weather::Fog { visibility_m }),
+        rain_mm_h.prop_map(|rate_mm_h| Weather::Rain { rate_mm_h }),
+        snow_mm_h.prop_map(|rate_mm_h| Weather::Snow { rate_mm_h }),
+    ]
+}
+
+/// Adverse weather as met on the road: fog of 30 to 200 m visibility, rain of 1 to 50 mm/h, snow
+/// of 0.5 to 5 mm/h.
+///
+/// ```
+/// use proptest::strategy::{Strategy, ValueTree};
+/// let mut runner = proptest::test_runner::TestRunner::deterministic();
+/// let w = groundtruth_scenario::strategies::weather().new_tree(&mut runner).unwrap().current();
+/// assert!(w.extinction_per_m() > 0.0, "{w:?}");
+/// ```
+pub fn weather() -> impl Strategy<Value = Weather> {
+    weathers(30.0..=200.0, 1.0..=50.0, 0.5..=5.0)
 }
 
 /// A deterministic proptest configuration: [`cases`]`(default)` cases, the random stream seeded

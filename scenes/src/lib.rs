@@ -51,6 +51,9 @@ pub struct Scene {
     pub family: String,
     /// The seed the generator used (file seed + caller seed, wrapping).
     pub seed: u64,
+    /// The file's `[weather]` table, if any: the weather scans of this scene use unless told
+    /// otherwise.
+    pub weather: Option<sim::effects::weather::Weather>,
 }
 
 /// The bundled scene files, by name.
@@ -126,6 +129,7 @@ pub fn load_str(text: &str, source_name: &str, base_dir: &Path, seed: u64) -> Re
         name: source_name.to_string(),
         family: header.family,
         seed: effective_seed,
+        weather: header.weather,
     })
 }
 

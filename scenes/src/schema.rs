@@ -16,6 +16,9 @@ pub struct Header {
     pub family: String,
     /// The file's own seed, if any.
     pub seed: Option<u64>,
+    /// The `[weather]` table, if any (`kind = "fog"`, `visibility_m = 50`; see
+    /// [`sim::effects::weather::Weather`]).
+    pub weather: Option<sim::effects::weather::Weather>,
 }
 
 #[derive(Deserialize)]
@@ -23,6 +26,7 @@ struct RawHeader {
     version: Option<toml::Value>,
     family: Option<String>,
     seed: Option<u64>,
+    weather: Option<toml::Value>,
 }
 
 /// Reads `version`, `family` and `seed`, checking the version.
@@ -50,7 +54,18 @@ pub fn header(text: &str, source_name: &str) -> Result<Header, SceneError> {
         source_name: source_name.into(),
         message: "missing `family` (the generator, e.g. family = \"ramp\")".into(),
     })?;
-    Ok(Header { family, seed: raw.seed })
+    let weather = match raw.weather {
+        None => None,
+        Some(v) => {
+            let w: sim::effects::weather::Weather = v.try_into().map_err(|e: toml::de::Error| SceneError::Toml {
+                source_name: source_name.into(),
+                message: format!("[weather]: {} (kinds: clear, fog with visibility_m, rain or snow with rate_mm_h)", e.message()),
+            })?;
+            w.validate().map_err(|e| SceneError::Toml { source_name: source_name.into(), message: format!("[weather]: {e}") })?;
+            Some(w)
+        }
+    };
+    Ok(Header { family, seed: raw.seed, weather })
 }
 
 /// A whole scene file with the parameters of one family.
@@ -70,6 +85,9 @@ pub struct Doc<P> {
     /// User meshes.
     #[serde(default)]
     pub mesh: Vec<MeshEntry>,
+    /// The weather (read by [`header`]).
+    #[serde(default)]
+    pub weather: Option<toml::Value>,
 }
 
 /// Parses the whole file with the parameter type `P` of its family.

@@ -7,6 +7,7 @@
 //! `intensity_reference_m` (targets nearer than `r_ref` saturate the range term).
 
 pub mod variation;
+pub mod weather;
 
 use crate::sensor::Measurement;
 

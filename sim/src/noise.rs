@@ -15,6 +15,8 @@ pub enum Purpose {
     Dropout = 2,
     /// Sub-beam sampling inside the beam divergence cone.
     Divergence = 3,
+    /// Weather: particles in the beam, the range of a fog return.
+    Weather = 4,
 }
 
 /// The key of one beam's stream.

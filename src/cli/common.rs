@@ -9,6 +9,8 @@ pub struct LoadedScene {
     pub mesh: SceneMesh,
     /// Ground height below the ego vehicle's start, metres.
     pub ego_ground_z_m: f32,
+    /// The scene file's `[weather]`, if any.
+    pub weather: Option<sim::effects::weather::Weather>,
 }
 
 /// Name of the 1.3 M-triangle benchmark terrain (`sim::cast::fixture`), accepted wherever a scene is.
@@ -28,12 +30,12 @@ pub fn scene_names() -> Vec<String> {
 /// Loads a scene by bundled name, built-in name, or TOML file path, generated with `seed`.
 pub fn load_scene_full(name_or_file: &str, seed: u64) -> anyhow::Result<LoadedScene> {
     if name_or_file == FIXTURE_TERRAIN {
-        return Ok(LoadedScene { mesh: sim::cast::fixture::terrain_scene(), ego_ground_z_m: 0.0 });
+        return Ok(LoadedScene { mesh: sim::cast::fixture::terrain_scene(), ego_ground_z_m: 0.0, weather: None });
     }
     let is_builtin = sim::scene::builtin::NAMES.contains(&name_or_file);
     let is_bundled = scenes::bundled_names().contains(&name_or_file);
     if is_builtin && !is_bundled {
-        return Ok(LoadedScene { mesh: sim::scene::builtin::builtin(name_or_file)?, ego_ground_z_m: 0.0 });
+        return Ok(LoadedScene { mesh: sim::scene::builtin::builtin(name_or_file)?, ego_ground_z_m: 0.0, weather: None });
     }
     if !is_bundled && !name_or_file.ends_with(".toml") {
         anyhow::bail!(
@@ -42,12 +44,20 @@ pub fn load_scene_full(name_or_file: &str, seed: u64) -> anyhow::Result<LoadedSc
         );
     }
     let scene = scenes::load(name_or_file, seed).with_context(|| format!("loading scene `{name_or_file}`"))?;
-    Ok(LoadedScene { mesh: scene.mesh, ego_ground_z_m: scene.ego_ground_z_m })
+    Ok(LoadedScene { mesh: scene.mesh, ego_ground_z_m: scene.ego_ground_z_m, weather: scene.weather })
 }
 
 /// Loads a scene's mesh (see [`load_scene_full`]).
 pub fn load_scene(name_or_file: &str, seed: u64) -> anyhow::Result<SceneMesh> {
     Ok(load_scene_full(name_or_file, seed)?.mesh)
+}
+
+/// The weather of a scan: `--weather SPEC` when given, else the scene file's `[weather]`.
+pub fn weather(spec: Option<&str>, scene: &LoadedScene) -> anyhow::Result<Option<sim::effects::weather::Weather>> {
+    match spec {
+        Some(s) => Ok(Some(sim::effects::weather::Weather::parse(s).context("--weather")?)),
+        None => Ok(scene.weather),
+    }
 }
 
 /// Loads a rig by preset name or TOML file path.

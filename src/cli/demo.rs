@@ -52,6 +52,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         format: "pcd,ply,kitti,las".into(),
         pcd_layout: "groundtruth".into(),
         bag_compression: "zstd".into(),
+        weather: None,
         threads: None,
         backend: "bvh".into(),
     };

@@ -48,6 +48,11 @@ pub struct Args {
     /// layout of the bag's clouds.
     #[arg(long, default_value = "groundtruth")]
     pub pcd_layout: String,
+    /// Weather per beam: `clear` (detection thresholds only), `fog:visibility_m=V`,
+    /// `rain:rate_mm_h=R` or `snow:rate_mm_h=R` (default: the scene file's `[weather]`, else none).
+    /// Returns from the medium are labelled fog (150), rain (151) or snow (152).
+    #[arg(long)]
+    pub weather: Option<String>,
     /// Chunk compression of the bag (`--format mcap`): `zstd` (level 1, as `ros2 bag record -s
     /// mcap` writes) or `none` (larger files, no compression work).
     #[arg(long, default_value = "zstd")]
@@ -110,6 +115,7 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
     let backend = parse_backend(&args.backend)?;
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;
+    let weather = super::common::weather(args.weather.as_deref(), &scene)?;
     let config = ScanConfig {
         seed: args.seed,
         frames: args.frames,
@@ -119,6 +125,7 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         backend,
         ego_z_m: scene.ego_ground_z_m,
         waypoints_m: Vec::new(),
+        weather,
     };
     let scanner = Scanner::new(&scene.mesh, &rig, config)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating output directory {}", args.out.display()))?;
@@ -220,6 +227,7 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         ideal: args.ideal,
         speed_m_per_s: args.speed,
         yaw_rate_rad_per_s: args.yaw_rate,
+        weather: weather.filter(|_| !args.ideal).map(|w| w.spec()),
         frame_period_s: scanner.frame_period_s(),
         kitti_frame: if single { "sensor" } else { "vehicle" }.to_string(),
         pcd_layout: formats.pcd_layout.name().to_string(),

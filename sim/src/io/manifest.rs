@@ -81,6 +81,9 @@ pub struct Manifest {
     pub speed_m_per_s: f32,
     /// Ego yaw rate, radians per second.
     pub yaw_rate_rad_per_s: f32,
+    /// The weather the scan was made in (`fog:visibility_m=50`; absent without weather).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weather: Option<String>,
     /// Frame period, seconds.
     pub frame_period_s: f64,
     /// Frame in which KITTI files hold their points: `sensor` (single-sensor rig) or `vehicle`.

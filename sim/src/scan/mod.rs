@@ -66,6 +66,9 @@ pub struct ScanConfig {
     /// Waypoints `[x, y]` the ego follows at `speed_m_per_s` (world frame, metres; none, or 2 or
     /// more): see [`crate::motion::Trajectory::waypoints_m`]. The yaw rate is then unused.
     pub waypoints_m: Vec<[f64; 2]>,
+    /// Weather decided per beam ([`crate::effects::weather`]); `None`: the sensors as they always
+    /// were (no detection threshold, no medium). Not applied with `ideal`.
+    pub weather: Option<crate::effects::weather::Weather>,
 }
 
 impl Default for ScanConfig {
@@ -79,6 +82,7 @@ impl Default for ScanConfig {
             backend: Backend::Bvh,
             ego_z_m: 0.0,
             waypoints_m: Vec::new(),
+            weather: None,
         }
     }
 }
@@ -92,6 +96,9 @@ impl ScanConfig {
         check_range("speed_m_per_s", f64::from(self.speed_m_per_s), -100.0, 100.0)?;
         check_range("yaw_rate_rad_per_s", f64::from(self.yaw_rate_rad_per_s), -2.0, 2.0)?;
         check_range("ego_z_m", f64::from(self.ego_z_m), -10_000.0, 10_000.0)?;
+        if let Some(w) = &self.weather {
+            w.validate()?;
+        }
         match self.waypoints_m.len() {
             0 => Ok(()),
             1 => Err(SimError::invalid("waypoints_m", 1, "none, or 2 or more points")),
@@ -135,6 +142,8 @@ pub struct Scanner<'a> {
     surfaces: Arc<Vec<Surface>>,
     patterns: Vec<ScanPattern>,
     measurements: Vec<Measurement>,
+    /// Per sensor, the weather's threshold and medium (none without weather or with `ideal`).
+    weather: Vec<Option<crate::effects::weather::SensorWeather>>,
     vehicle_from_sensor: Vec<Affine3A>,
     layout: RigLayout,
     /// `row_source[merged_row] = (sensor, ring)`.
@@ -223,6 +232,12 @@ impl<'a> Scanner<'a> {
             .iter()
             .map(|s| if config.ideal { s.spec.measurement().ideal() } else { s.spec.measurement() })
             .collect();
+        let weather = measurements
+            .iter()
+            .map(|m| {
+                config.weather.filter(|_| !config.ideal).map(|w| crate::effects::weather::SensorWeather::new(&w, m))
+            })
+            .collect();
         let vehicle_from_sensor = rig.sensors.iter().map(|s| s.mount.vehicle_from_sensor()).collect();
         let layout = RigLayout::new(rig, &patterns);
         let mut row_source = vec![(0, 0); layout.rows];
@@ -248,6 +263,7 @@ impl<'a> Scanner<'a> {
             surfaces,
             patterns,
             measurements,
+            weather,
             vehicle_from_sensor,
             layout,
             row_source,

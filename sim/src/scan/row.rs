@@ -9,6 +9,7 @@ use super::rays::{NO_BEAM, RowBeams, ShotPose};
 use crate::cast::{Hit, Ray};
 use crate::cloud::OrderedCloud;
 use crate::effects::measure;
+use crate::effects::weather::BeamOutcome;
 use crate::layout::NO_COLUMN;
 use crate::noise::{BeamKey, Purpose, RowKey};
 use crate::scene::{SceneMesh, Surface};
@@ -205,6 +206,33 @@ impl Scanner<'_> {
                     echo += 1;
                 }
                 first
+            };
+            // Weather: the medium attenuates the return and may replace it with its own.
+            let first = match &self.weather[s] {
+                None => first,
+                Some(w) => {
+                    let key = BeamKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32, column: c as u32 };
+                    match w.beam(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key) {
+                        BeamOutcome::Target { intensity } => first.map(|cell| Cell { intensity, ..cell }),
+                        BeamOutcome::Medium { range_m, intensity, class } => {
+                            let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * range_m;
+                            Some(Cell {
+                                point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
+                                range_m,
+                                intensity,
+                                class,
+                                instance: 0,
+                                // Facing the sensor.
+                                normal: -vehicle_from_sensor.transform_vector3(f.dir_in_sensor),
+                                sensor: s as u8,
+                                ring: ring as u16,
+                                column: c as u32,
+                                time_s: start_time_s + f.time_s,
+                            })
+                        }
+                        BeamOutcome::Lost => None,
+                    }
+                }
             };
             match first {
                 Some(cell) => view.set_return(mc, &cell),

@@ -62,6 +62,20 @@ impl SemanticClass {
     pub const TRAFFIC_SIGN: Self = Self(81);
     /// Other object.
     pub const OTHER_OBJECT: Self = Self(99);
+    /// A return from fog (backscatter of the medium; ours, not a SemanticKITTI class).
+    pub const FOG: Self = Self(150);
+    /// A return from a raindrop in the beam (ours).
+    pub const RAIN: Self = Self(151);
+    /// A return from a snowflake in the beam (ours).
+    pub const SNOW: Self = Self(152);
+
+    /// The weather classes: fog, rain, snow.
+    pub const WEATHER: [Self; 3] = [Self::FOG, Self::RAIN, Self::SNOW];
+
+    /// Whether this is a return from the weather (fog, rain or snow) rather than a surface.
+    pub fn is_weather(self) -> bool {
+        (150..=152).contains(&self.0)
+    }
 
     /// The ground classes: road, parking, sidewalk, other-ground, lane-marking, terrain.
     pub const GROUND: [Self; 6] =
@@ -99,13 +113,15 @@ impl SemanticClass {
     /// The nearest ASPRS (LAS 1.4) classification: ground classes 2 (ground), bushes 4 (medium
     /// vegetation), canopy and trunks 5 (high vegetation), building 6, and the user-definable
     /// classes 64.. for the rest: car 64, truck 65, other-vehicle 66, person 67, fence 68,
-    /// other-structure 69, pole 70, traffic-sign 71, other-object 72; anything else (unlabeled
+    /// other-structure 69, pole 70, traffic-sign 71, other-object 72; weather returns (fog, rain,
+    /// snow) 18 (high noise, the class for returns from the air); anything else (unlabeled
     /// included) 1 (unclassified).
     pub fn las_class(self) -> u8 {
         if self.is_ground() {
             return 2;
         }
         match self.0 {
+            150..=152 => 18,
             73 => 4,
             70 | 71 => 5,
             50 => 6,
@@ -145,6 +161,9 @@ impl SemanticClass {
             80 => "pole",
             81 => "traffic-sign",
             99 => "other-object",
+            150 => "fog",
+            151 => "rain",
+            152 => "snow",
             _ => "other",
         }
     }
@@ -171,6 +190,9 @@ impl SemanticClass {
             73 => [0, 120, 160],
             80 => [255, 240, 150],
             81 => [255, 0, 0],
+            150 => [200, 200, 200],
+            151 => [90, 160, 255],
+            152 => [240, 250, 255],
             _ => [128, 128, 128],
         }
     }

@@ -55,6 +55,10 @@ pub struct DatasetConfig {
     /// Training parameters of `groundtruth train --config` (ignored by `groundtruth dataset`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub train: Option<super::generate::TrainSection>,
+    /// Weather of every sequence that sets none of its own (`[weather]`: `kind = "fog"`,
+    /// `visibility_m = 50`; see `sim::effects::weather`); else the scene file's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weather: Option<sim::effects::weather::Weather>,
 }
 
 fn default_name() -> String {
@@ -136,6 +140,10 @@ pub struct SequenceConfig {
     /// Intensities multiplied by this (clamped to 1), 0 ..= 10.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub intensity_scale: Option<f64>,
+    /// Weather of this sequence (`weather = { kind = "snow", rate_mm_h = 2 }`); default the
+    /// dataset's `[weather]`, else the scene file's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weather: Option<sim::effects::weather::Weather>,
 }
 
 impl DatasetConfig {
@@ -156,6 +164,11 @@ impl DatasetConfig {
             let drawn = g.draw(first)?;
             self.sequences.extend(drawn);
         }
+        if let Some(w) = self.weather {
+            for s in self.sequences.iter_mut().filter(|s| s.weather.is_none()) {
+                s.weather = Some(w);
+            }
+        }
         Ok(())
     }
 
@@ -168,6 +181,9 @@ impl DatasetConfig {
         let mut total = 0u64;
         for (k, s) in self.sequences.iter().enumerate() {
             let at = format!("sequences[{k}]");
+            if let Some(w) = &s.weather {
+                w.validate().map_err(|e| anyhow::anyhow!("`{at}.weather`: {e}"))?;
+            }
             if s.id > MAX_SEQUENCE_ID {
                 bail!("`{at}.id` = {}: allowed 0 ..= {MAX_SEQUENCE_ID} (two-digit SemanticKITTI folders)", s.id);
             }

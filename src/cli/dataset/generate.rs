@@ -178,6 +178,7 @@ impl Generate {
                 noise_scale,
                 dropout,
                 intensity_scale,
+                weather: None,
             });
         }
         Ok(out)

@@ -55,6 +55,7 @@ pub(crate) fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
             ideal: s.ideal,
             ego_z_m: scene.ego_ground_z_m,
             waypoints_m: s.waypoints_m.clone().unwrap_or_default(),
+            weather: s.weather.or(scene.weather),
             ..ScanConfig::default()
         };
         scan.validate().with_context(|| format!("`{at}`"))?;

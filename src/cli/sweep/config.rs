@@ -18,6 +18,12 @@
 //! frequency_hz = [12.5, 25.0]
 //! ```
 //!
+//! The weather is swept either as a list of kinds, `weather = ["clear", "fog:visibility_m=50",
+//! "snow:rate_mm_h=2"]` (top level, before any table; column `weather`), or over one kind's
+//! parameter, a numeric axis to plot against: `[weather]` with `kind = "fog"` and
+//! `visibility_m = { from = 20, to = 200, step = 20 }` (column `weather.visibility_m`); see
+//! `sim::effects::weather` for the kinds and ranges.
+//!
 //! A value list is a TOML array, or a range table `{ from, to, step }` (inclusive of `to` where
 //! the steps land on it; `step` defaults to 1). Mount values follow the manifest's `mount` (metres,
 //! degrees, ISO 8855, +pitch = down); see [`super::expand`] for what they mean for a whole rig.
@@ -35,6 +41,9 @@ pub const MAX_CONFIGURATIONS: u64 = 10_000_000;
 
 /// Largest number of values one list or range may hold.
 pub const MAX_VALUES: usize = 1_000_000;
+
+/// The weather axis's column name.
+pub const WEATHER_AXIS: &str = "weather";
 
 /// Largest number of frames per configuration.
 pub const MAX_FRAMES: usize = 100;
@@ -59,6 +68,16 @@ struct RawSweep {
     mount: BTreeMap<String, RawValues>,
     #[serde(default)]
     sensor: BTreeMap<String, RawValues>,
+    #[serde(default)]
+    weather: Option<RawWeather>,
+}
+
+/// The sweep's weather: a list of specs or one kind with its parameter's values.
+#[derive(Deserialize, Debug)]
+#[serde(untagged)]
+enum RawWeather {
+    Specs(Vec<String>),
+    Swept(BTreeMap<String, toml::Value>),
 }
 
 fn one() -> usize {
@@ -117,6 +136,8 @@ pub struct Sweep {
     pub mount: Vec<Axis>,
     /// Sensor spec axes (`sensor.<field>`), sorted by name.
     pub sensor: Vec<Axis>,
+    /// The weather axis (column `weather`, values as `fog:visibility_m=50`), if swept.
+    pub weather: Option<Axis>,
 }
 
 impl Sweep {
@@ -177,6 +198,26 @@ impl Sweep {
             }
             sensor.push(Axis { name: field.clone(), values: expand(&field, values, source)? });
         }
+        let weather = match raw.weather {
+            None => None,
+            Some(RawWeather::Specs(list)) => {
+                if list.is_empty() {
+                    bail!("{source}: `weather` is an empty list; give at least one (e.g. \"clear\")");
+                }
+                let mut values = Vec::new();
+                for spec in &list {
+                    let w = sim::effects::weather::Weather::parse(spec)
+                        .with_context(|| format!("{source}: `weather` entry `{spec}`"))?;
+                    let v = serde_json::Value::from(w.spec());
+                    if values.contains(&v) {
+                        bail!("{source}: `weather` lists `{spec}` twice");
+                    }
+                    values.push(v);
+                }
+                Some(Axis { name: WEATHER_AXIS.to_string(), values })
+            }
+            Some(RawWeather::Swept(table)) => Some(weather_axis(&table, source)?),
+        };
         Ok(Sweep {
             scenes: raw.scenes,
             rigs: raw.rigs,
@@ -188,12 +229,13 @@ impl Sweep {
             body: raw.body,
             mount,
             sensor,
+            weather,
         })
     }
 
-    /// Every swept parameter axis: mount axes, then sensor axes.
+    /// Every swept parameter axis: mount axes, then sensor axes, then the weather.
     pub fn axes(&self) -> impl Iterator<Item = &Axis> {
-        self.mount.iter().chain(&self.sensor)
+        self.mount.iter().chain(&self.sensor).chain(&self.weather)
     }
 
     /// The sweep as canonical JSON (lists expanded): equal sweeps give equal text.
@@ -212,6 +254,26 @@ impl Sweep {
             "axes": axes,
         })
     }
+}
+
+/// `[weather]` with `kind` and one parameter's values: the axis `weather.<parameter>`.
+fn weather_axis(table: &BTreeMap<String, toml::Value>, source: &str) -> anyhow::Result<Axis> {
+    let kind = match table.get("kind") {
+        Some(toml::Value::String(k)) => k.clone(),
+        _ => bail!("{source}: `weather.kind`: give the kind swept (fog, rain or snow) as a string"),
+    };
+    let params: Vec<(&String, &toml::Value)> = table.iter().filter(|(k, _)| k.as_str() != "kind").collect();
+    let [(name, raw)] = params.as_slice() else {
+        bail!("{source}: `[weather]`: give `kind` and the values of exactly one of its parameters");
+    };
+    let field = format!("weather.{name}");
+    let raw: RawValues = toml::Value::clone(raw).try_into().with_context(|| format!("{source}: `{field}`: a list or a range table"))?;
+    let values = expand(&field, &raw, source)?;
+    for v in &values {
+        sim::effects::weather::Weather::parse(&format!("{kind}:{name}={v}"))
+            .with_context(|| format!("{source}: `{field}` value {v}"))?;
+    }
+    Ok(Axis { name: format!("{WEATHER_AXIS}.{kind}.{name}"), values })
 }
 
 /// A TOML value as JSON (numbers, strings and booleans only).

@@ -90,6 +90,7 @@ pub fn evaluate(
         speed_m_per_s: sweep.speed_m_per_s,
         ideal: sweep.ideal,
         ego_z_m: scene.ego_ground_z_m,
+        weather: space.weather(c)?.or(scene.weather),
         ..Default::default()
     };
     let scanner = Scanner::with_prepared(&scene.mesh, &rig, config, prepared).context("setting up the scan")?;

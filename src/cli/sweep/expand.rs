@@ -162,6 +162,20 @@ impl Space {
         stable_key(&text)
     }
 
+    /// The weather of configuration `c` (`None` when the sweep has no weather axis).
+    pub fn weather(&self, c: &Configuration) -> anyhow::Result<Option<sim::effects::weather::Weather>> {
+        let Some((name, v)) = self.params(c).find(|(name, _)| name.split('.').next() == Some(super::config::WEATHER_AXIS))
+        else {
+            return Ok(None);
+        };
+        // `weather` holds specs; `weather.KIND.FIELD` one field's numbers.
+        let spec = match name.split('.').collect::<Vec<_>>().as_slice() {
+            [_, kind, field] => format!("{kind}:{field}={v}"),
+            _ => v.as_str().unwrap_or_default().to_string(),
+        };
+        Ok(Some(sim::effects::weather::Weather::parse(&spec)?))
+    }
+
     /// The rig of configuration `c`.
     pub fn rig(&self, c: &Configuration) -> anyhow::Result<Rig> {
         let values: Vec<Option<usize>> = c.values.iter().map(|&k| Some(k)).collect();
@@ -176,6 +190,9 @@ impl Space {
         for (axis, k) in self.sweep.axes().zip(values) {
             let Some(k) = *k else { continue };
             let v = &axis.values[k];
+            if axis.name.split('.').next() == Some(super::config::WEATHER_AXIS) {
+                continue;
+            }
             if let Some(p) = super::config::MOUNT_PARAMS.iter().position(|&m| m == axis.name) {
                 mount[p] = Some(v.as_f64().context("mount values are numbers")? as f32);
             } else {
