@@ -11,7 +11,7 @@ use crate::error::{scenario_error, type_error, value_error};
 use crate::frame::Frame;
 
 /// Every region name `parse_region` takes without an argument.
-pub const REGIONS: [&str; 11] = [
+pub const REGIONS: [&str; 12] = [
     "all",
     "ground",
     "non-ground",
@@ -23,6 +23,7 @@ pub const REGIONS: [&str; 11] = [
     "vehicle-roofs",
     "hill-slope",
     "vegetation",
+    "weather",
 ];
 
 /// The region called `name` (its `Display` name in the Rust API), or `class:<name or id>`,
@@ -49,6 +50,7 @@ pub fn parse_region(name: &str) -> PyResult<Region> {
         "vehicle-roofs" => Region::VehicleRoofs,
         "hill-slope" => Region::HillSlope,
         "vegetation" => Region::Vegetation,
+        "weather" => Region::Weather,
         _ => {
             if let Some(c) = name.strip_prefix("class:") {
                 let spec = match c.parse::<u16>() {

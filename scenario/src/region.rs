@@ -72,6 +72,9 @@ pub enum Region {
     HillSlope,
     /// Vegetation: canopy (70), trunks (71) and bushes (73).
     Vegetation,
+    /// Returns from the weather: fog (150), rain (151) and snow (152) (never ground; a method that
+    /// calls them ground reports false ground).
+    Weather,
     /// Returns whose range is in `min_m ..max_m` (metres from the beam origin).
     RangeBand {
         /// Inclusive lower bound, metres.
@@ -99,6 +102,7 @@ impl fmt::Display for Region {
             Self::VehicleRoofs => write!(f, "vehicle-roofs"),
             Self::HillSlope => write!(f, "hill-slope"),
             Self::Vegetation => write!(f, "vegetation"),
+            Self::Weather => write!(f, "weather"),
             Self::RangeBand { min_m, max_m } => write!(f, "range {min_m}-{max_m} m"),
             Self::Class(c) => write!(f, "class {}", c.name()),
             Self::Instance(i) => write!(f, "instance {i}"),
@@ -197,6 +201,7 @@ impl Region {
                     ground && world().x <= h.crest_x_m - 0.5 * h.crest_length_m
                 }
                 Self::Vegetation => matches!(label.0, 70 | 71 | 73),
+                Self::Weather => label.is_weather(),
                 Self::RangeBand { min_m, max_m } => (*min_m..*max_m).contains(&c.range_m[i]),
                 Self::Class(k) => label == *k,
                 Self::Instance(k) => c.instance[i] == *k,

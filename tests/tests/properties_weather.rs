@@ -1,0 +1,236 @@
+//! Weather properties: what fog, rain and snow do to a scan, and what they do to our ground
+//! classifiers, drawn with `groundtruth_scenario::strategies::weather()` on the road scenes.
+//!
+//! - The scan: the same seed gives the same bytes at 1 and 2 threads; every return that is not
+//!   the medium's keeps its clear-weather range, label and ground truth, its intensity only lower;
+//!   the medium's returns are labelled fog / rain / snow and never ground; thinner fog never
+//!   turns more beams into fog.
+//! - The classifiers: per method and weather kind, the ground recall on the road scenes and the
+//!   false-ground rate of the medium's returns (particles near the ground called ground). Each
+//!   case prints `PROP <property> <method> <value>`; the bound tables carry the worst values seen.
+//!
+//! Case counts are CI-sized (4 per property), seeded with `GT_PROPTEST_SEED` (default 0);
+//! `GT_PROPTEST_CASES=N` runs N.
+
+use groundtruth_scenario::strategies::{self, config};
+use groundtruth_scenario::{Region, RegionScore, Scan, Scenario, Weather};
+use proptest::prelude::*;
+use proptest::test_runner::TestCaseError;
+use sim::cloud::OrderedCloud;
+use sim::rig::Rig;
+use sim::scan::{Frame, ScanConfig, scan};
+use sim::scene::SemanticClass;
+
+const METHODS: [&str; 5] = ["nitsch", "ransac", "grid", "mcdaniel", "learned"];
+
+fn bits(c: &OrderedCloud) -> Vec<u64> {
+    let mut v: Vec<u64> = Vec::new();
+    v.extend(c.point_in_vehicle.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
+    v.extend(c.normal.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
+    v.extend(c.range_m.iter().map(|x| u64::from(x.to_bits())));
+    v.extend(c.intensity.iter().map(|x| u64::from(x.to_bits())));
+    v.extend(c.time_s.iter().map(|x| x.to_bits()));
+    v.extend(c.label.iter().map(|x| u64::from(x.0)));
+    v.extend(c.instance.iter().map(|&x| u64::from(x)));
+    v.extend(c.ground.iter().map(|&x| u64::from(x)));
+    v
+}
+
+fn scan_with_threads(threads: usize, scene: &scenes::Scene, rig: &Rig, config: &ScanConfig) -> Vec<Frame> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| scan(&scene.mesh, rig, config).unwrap())
+}
+
+fn road_scene() -> impl Strategy<Value = &'static str> {
+    prop::sample::select(vec!["city", "highway", "rural"])
+}
+
+fn scan_of(s: Scenario) -> Result<Scan, TestCaseError> {
+    s.scan().map_err(|e| TestCaseError::fail(e.to_string()))
+}
+
+fn kind(w: &Weather) -> &'static str {
+    match w {
+        Weather::Clear => "clear",
+        Weather::Fog { .. } => "fog",
+        Weather::Rain { .. } => "rain",
+        Weather::Snow { .. } => "snow",
+    }
+}
+
+/// A bound per method (nitsch, ransac, grid, mcdaniel, learned): `Some(b)` asserted, `None`
+/// printed only (a documented known limit with a named test below).
+type Bounds = [Option<f64>; 5];
+
+/// Ground recall lost to the weather on the road scenes (city, highway, rural; HDL-64E on the
+/// roof), per kind: clear-air recall minus weather recall, at most. Worst values seen: see the
+/// comments and docs/weather.md.
+// Worst of 40 cases (GT_PROPTEST_CASES=40, seed 0; fog 12, rain 17, snow 11 cases), in method
+// order: fog 0.444, 0.0015, 0.557, 0.029, 0.018; rain 0.459, 0.028, 0.494, 0.027, 0.062; snow
+// 0.583, 0.037, 0.965, 0.055, 0.091. nitsch and grid (the same cluster rules) are a known failure:
+// `nitsch_and_grid_lose_the_road_when_fog_cuts_the_far_ground`, `snow_clutter_breaks_nitsch_and_grid`.
+const FOG_RECALL_DROP: Bounds = [None, Some(0.01), None, Some(0.05), Some(0.03)];
+const RAIN_RECALL_DROP: Bounds = [None, Some(0.05), None, Some(0.05), Some(0.08)];
+const SNOW_RECALL_DROP: Bounds = [None, Some(0.06), None, Some(0.08), Some(0.12)];
+/// Share of the medium's returns called ground, per kind. Fog returns hang 1-8 m in front of the
+/// sensor, above the road; snow and rain returns are anywhere in the beam, some just above the
+/// road. Worst of the 40 cases: fog 0.0009 (nitsch), rain 0.0039 (nitsch), snow 0.0168 (ransac),
+/// 0.0153 (mcdaniel), 0.0069 (learned).
+const FOG_FALSE_GROUND: Bounds = [Some(0.005); 5];
+const RAIN_FALSE_GROUND: Bounds = [Some(0.01); 5];
+const SNOW_FALSE_GROUND: Bounds = [Some(0.03); 5];
+
+fn bounds(w: &Weather) -> (&'static Bounds, &'static Bounds) {
+    match w {
+        Weather::Fog { .. } | Weather::Clear => (&FOG_RECALL_DROP, &FOG_FALSE_GROUND),
+        Weather::Rain { .. } => (&RAIN_RECALL_DROP, &RAIN_FALSE_GROUND),
+        Weather::Snow { .. } => (&SNOW_RECALL_DROP, &SNOW_FALSE_GROUND),
+    }
+}
+
+/// Prints the value and checks it is at most `bound`.
+fn check(
+    property: &str,
+    case: &str,
+    v: f64,
+    s: &RegionScore,
+    method: &str,
+    bound: Option<f64>,
+) -> Result<(), TestCaseError> {
+    eprintln!("PROP {property} {method} {v:.4} ({case}; {s})");
+    if let Some(b) = bound {
+        prop_assert!(v <= b, "{property}: {method} {v:.4} against bound {b} on {case}: {s}");
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(4))]
+
+    /// The same seed gives the same bytes at 1 and 2 threads in every weather.
+    #[test]
+    fn weather_scans_are_the_same_at_one_and_two_threads(
+        scene in road_scene(),
+        seed in 0u64..1_000_000,
+        weather in strategies::weather(),
+    ) {
+        let scene = scenes::load_bundled(scene, seed).unwrap();
+        let rig = Rig::preset("vlp16-roof").unwrap();
+        let config = ScanConfig { seed, frames: 2, speed_m_per_s: 8.0, ego_z_m: scene.ego_ground_z_m, weather: Some(weather), ..ScanConfig::default() };
+        let one = scan_with_threads(1, &scene, &rig, &config);
+        let two = scan_with_threads(2, &scene, &rig, &config);
+        for (a, b) in one.iter().zip(&two) {
+            prop_assert!(bits(&a.cloud) == bits(&b.cloud), "frame {} differs ({weather:?})", a.index);
+        }
+    }
+
+    /// Against `clear` (the same detection threshold, no medium): every return of the weather scan
+    /// that is not the medium's is the same surface point with the same label and ground truth, at
+    /// most as bright; the medium's returns are labelled as the weather's kind, never ground, and
+    /// lie nearer than the beam's clear-weather return.
+    #[test]
+    fn weather_keeps_ground_truth_and_labels_its_own_returns(
+        scene in road_scene(),
+        seed in 0u64..1_000_000,
+        weather in strategies::weather(),
+    ) {
+        let clear = scan_of(Scenario::bundled(scene).rig("hdl64e-roof").seed(seed).weather(Weather::Clear))?;
+        let wet = scan_of(Scenario::bundled(scene).rig("hdl64e-roof").seed(seed).weather(weather))?;
+        let (a, b) = (&clear.frames()[0].cloud, &wet.frames()[0].cloud);
+        let class = match weather {
+            Weather::Fog { .. } => SemanticClass::FOG,
+            Weather::Rain { .. } => SemanticClass::RAIN,
+            _ => SemanticClass::SNOW,
+        };
+        let (mut medium, mut kept) = (0, 0);
+        for i in (0..b.len()).filter(|&i| b.has_return(i)) {
+            if b.label[i].is_weather() {
+                medium += 1;
+                prop_assert_eq!(b.label[i], class);
+                prop_assert!(!b.ground[i]);
+                prop_assert!(!a.has_return(i) || b.range_m[i] < a.range_m[i], "cell {}: {} vs {}", i, b.range_m[i], a.range_m[i]);
+            } else {
+                kept += 1;
+                prop_assert!(a.has_return(i), "cell {} returns only in weather", i);
+                prop_assert_eq!(a.range_m[i].to_bits(), b.range_m[i].to_bits());
+                prop_assert_eq!(a.label[i], b.label[i]);
+                prop_assert_eq!(a.ground[i], b.ground[i]);
+                prop_assert!(b.intensity[i] <= a.intensity[i], "cell {}", i);
+            }
+        }
+        eprintln!("{scene} seed {seed} {weather:?}: {medium} medium returns, {kept} kept of {}", a.returns());
+        prop_assert!(kept > 0);
+    }
+
+    /// Thinner fog never turns more beams into fog returns (visibility v < 2v: a superset of beams).
+    #[test]
+    fn thinner_fog_fogs_fewer_beams(scene in road_scene(), seed in 0u64..1_000, v in 20.0f64..100.0) {
+        let fogged = |visibility_m: f64| -> Result<usize, TestCaseError> {
+            let s = scan_of(Scenario::bundled(scene).rig("vlp16-roof").seed(seed).weather(Weather::Fog { visibility_m }))?;
+            let c = &s.frames()[0].cloud;
+            Ok((0..c.len()).filter(|&i| c.has_return(i) && c.label[i] == SemanticClass::FOG).count())
+        };
+        let (thick, thin) = (fogged(v)?, fogged(2.0 * v)?);
+        prop_assert!(thin <= thick, "V {v}: {thick} fog returns, at 2V {thin}");
+    }
+
+    /// Per method: the ground recall lost to the weather (recall in clear air minus recall in the
+    /// weather, same scene, seed and rig) on the road scenes, and the share of the medium's
+    /// returns it calls ground (bounds per kind above).
+    #[test]
+    fn ground_segmentation_in_weather(scene in road_scene(), seed in 0u64..1_000_000, weather in strategies::weather()) {
+        let s = Scenario::bundled(scene).rig("hdl64e-roof").seed(seed);
+        let clear = scan_of(s.clone().weather(Weather::Clear))?;
+        let wet = scan_of(s.weather(weather))?;
+        let case = format!("{scene} seed {seed} {}", weather.spec());
+        let (drop_bounds, false_bounds) = bounds(&weather);
+        for (k, method) in METHODS.iter().enumerate() {
+            let fail = |e: groundtruth_scenario::ScenarioError| TestCaseError::fail(format!("{method}: {e}"));
+            let before = clear.score(&Region::Ground, &clear.classify(method).map_err(fail)?).map_err(fail)?;
+            let d = wet.classify(method).map_err(fail)?;
+            let after = wet.score(&Region::Ground, &d).map_err(fail)?;
+            let drop = before.recall() - after.recall();
+            let name = format!("{}_ground_recall_drop", kind(&weather));
+            check(&name, &format!("{case}; clear {:.4}", before.recall()), drop, &after, method, drop_bounds[k])?;
+            // Thin fog (visibility above about 90 m) returns nothing of its own: no region to score.
+            if let Ok(w) = wet.score(&Region::Weather, &d) {
+                check(&format!("{}_false_ground", kind(&weather)), &case, w.false_ground_rate(), &w, method, false_bounds[k])?;
+            }
+        }
+    }
+}
+
+/// Ground recall of `method` on `scene` (HDL-64E on the roof) in clear air and in `weather`.
+fn recalls(scene: &str, seed: u64, weather: Weather, method: &str) -> (f64, f64) {
+    let s = Scenario::bundled(scene).rig("hdl64e-roof").seed(seed);
+    let r = |w: Weather| s.clone().weather(w).scan().unwrap().score_method(method, &Region::Ground).unwrap().recall();
+    let (clear, wet) = (r(Weather::Clear), r(weather));
+    eprintln!("{method} {scene} seed {seed} {}: ground recall {clear:.4} clear, {wet:.4}", weather.spec());
+    (clear, wet)
+}
+
+/// Known failure: fog of 166 m visibility returns nothing of its own but attenuates the far ground
+/// below the detection threshold (no ground beyond about 40 m). On `rural` (seed 248540) the
+/// road near the car is then no longer the largest cluster of Nitsch et al.'s rule 2 (the grid map
+/// uses the same rules), and most of it is rejected: nitsch 0.933 -> 0.489, grid 0.951 -> 0.39 on
+/// `highway` (seed 652352, visibility 77 m).
+#[test]
+fn nitsch_and_grid_lose_the_road_when_fog_cuts_the_far_ground() {
+    let (clear, fog) = recalls("rural", 248_540, Weather::Fog { visibility_m: 166.0 }, "nitsch");
+    assert!(clear > 0.9 && fog < 0.6, "{clear} -> {fog}");
+    let (clear, fog) = recalls("highway", 652_352, Weather::Fog { visibility_m: 77.0 }, "grid");
+    assert!(clear > 0.9 && fog < 0.6, "{clear} -> {fog}");
+    // The learned segmenter keeps it.
+    let (clear, fog) = recalls("rural", 248_540, Weather::Fog { visibility_m: 166.0 }, "learned");
+    assert!(clear - fog < 0.03, "{clear} -> {fog}");
+}
+
+/// Known failure: snow returns scattered over the grid cut the ground's clusters into pieces, and
+/// nitsch and grid reject most of the road: nitsch 0.947 -> 0.364 on `city` (seed 15402, 4.7
+/// mm/h), grid 0.965 -> 0.0 on `highway` (seed 109, 5 mm/h).
+#[test]
+fn snow_clutter_breaks_nitsch_and_grid() {
+    let (clear, snow) = recalls("city", 15_402, Weather::Snow { rate_mm_h: 4.7 }, "nitsch");
+    assert!(clear > 0.9 && snow < 0.6, "{clear} -> {snow}");
+    let (clear, snow) = recalls("highway", 109, Weather::Snow { rate_mm_h: 5.0 }, "grid");
+    assert!(clear > 0.9 && snow < 0.3, "{clear} -> {snow}");
+}
