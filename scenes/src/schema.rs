@@ -59,9 +59,15 @@ pub fn header(text: &str, source_name: &str) -> Result<Header, SceneError> {
         Some(v) => {
             let w: sim::effects::weather::Weather = v.try_into().map_err(|e: toml::de::Error| SceneError::Toml {
                 source_name: source_name.into(),
-                message: format!("[weather]: {} (kinds: clear, fog with visibility_m, rain or snow with rate_mm_h)", e.message()),
+                message: format!(
+                    "[weather]: {} (kinds: clear, fog with visibility_m, rain or snow with rate_mm_h)",
+                    e.message()
+                ),
             })?;
-            w.validate().map_err(|e| SceneError::Toml { source_name: source_name.into(), message: format!("[weather]: {e}") })?;
+            w.validate().map_err(|e| SceneError::Toml {
+                source_name: source_name.into(),
+                message: format!("[weather]: {e}"),
+            })?;
             Some(w)
         }
     };

@@ -33,6 +33,10 @@ pub struct Args {
     /// Ego speed, metres per second (0: a standing vehicle).
     #[arg(long, default_value_t = 0.0)]
     pub speed: f32,
+    /// Also time full frames in these weathers (`fog:visibility_m=50 snow:rate_mm_h=2 ...`),
+    /// interleaved with the plain frame: `weather[].added` is the share of time they add.
+    #[arg(long, num_args = 1..)]
+    pub weather: Vec<String>,
 }
 
 /// Runs the benchmark.
@@ -51,8 +55,24 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
     let rig = super::common::load_rig(&args.rig)?;
     let t0 = Instant::now();
     let config = ScanConfig { ego_z_m: scene.ego_ground_z_m, speed_m_per_s: args.speed, ..ScanConfig::default() };
-    let scanner = Scanner::new(&scene.mesh, &rig, config)?;
+    let prepared = sim::scan::PreparedScene::new(&scene.mesh, config.backend)?;
+    let scanner = Scanner::with_prepared(&scene.mesh, &rig, config.clone(), &prepared)?;
     let setup_s = t0.elapsed().as_secs_f64();
+    let weathers = args
+        .weather
+        .iter()
+        .map(|spec| {
+            let w = sim::effects::weather::Weather::parse(spec)?;
+            let s = Scanner::with_prepared(
+                &scene.mesh,
+                &rig,
+                ScanConfig { weather: Some(w), ..config.clone() },
+                &prepared,
+            )?;
+            Ok((w, s, f64::INFINITY, 0usize))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut weathers = weathers;
 
     let rows = scanner.rows();
     let all_rays: Vec<_> = (0..rows).map(|r| scanner.row_rays(0, r).rays).collect();
@@ -74,7 +94,25 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
         let t = Instant::now();
         scanner.frame_into(0, &mut cloud);
         full_s = full_s.min(t.elapsed().as_secs_f64());
+        for (_, s, best, returns) in &mut weathers {
+            let t = Instant::now();
+            s.frame_into(0, &mut cloud);
+            *best = best.min(t.elapsed().as_secs_f64());
+            *returns = cloud.returns();
+        }
+        scanner.frame_into(0, &mut cloud);
     }
+    let weather: Vec<serde_json::Value> = weathers
+        .iter()
+        .map(|(w, _, best, returns)| {
+            serde_json::json!({
+                "weather": w.spec(),
+                "full_frame_ms": best * 1e3,
+                "added": best / full_s - 1.0,
+                "returns": returns,
+            })
+        })
+        .collect();
     Ok(serde_json::json!({
         "bench": "scan",
         "scene": args.scene,
@@ -89,5 +127,6 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
         "full_frame_ms": full_s * 1e3,
         "overhead": full_s / bare_s - 1.0,
         "rays_per_s_full": rays as f64 / full_s,
+        "weather": weather,
     }))
 }

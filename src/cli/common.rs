@@ -35,7 +35,11 @@ pub fn load_scene_full(name_or_file: &str, seed: u64) -> anyhow::Result<LoadedSc
     let is_builtin = sim::scene::builtin::NAMES.contains(&name_or_file);
     let is_bundled = scenes::bundled_names().contains(&name_or_file);
     if is_builtin && !is_bundled {
-        return Ok(LoadedScene { mesh: sim::scene::builtin::builtin(name_or_file)?, ego_ground_z_m: 0.0, weather: None });
+        return Ok(LoadedScene {
+            mesh: sim::scene::builtin::builtin(name_or_file)?,
+            ego_ground_z_m: 0.0,
+            weather: None,
+        });
     }
     if !is_bundled && !name_or_file.ends_with(".toml") {
         anyhow::bail!(

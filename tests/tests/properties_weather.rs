@@ -37,7 +37,11 @@ fn bits(c: &OrderedCloud) -> Vec<u64> {
 }
 
 fn scan_with_threads(threads: usize, scene: &scenes::Scene, rig: &Rig, config: &ScanConfig) -> Vec<Frame> {
-    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| scan(&scene.mesh, rig, config).unwrap())
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| scan(&scene.mesh, rig, config).unwrap())
 }
 
 fn road_scene() -> impl Strategy<Value = &'static str> {

@@ -211,7 +211,13 @@ impl Scanner<'_> {
             let first = match &self.weather[s] {
                 None => first,
                 Some(w) => {
-                    let key = BeamKey { seed: self.config.seed, frame: frame as u32, sensor: s as u32, ring: ring as u32, column: c as u32 };
+                    let key = BeamKey {
+                        seed: self.config.seed,
+                        frame: frame as u32,
+                        sensor: s as u32,
+                        ring: ring as u32,
+                        column: c as u32,
+                    };
                     match w.beam(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key) {
                         BeamOutcome::Target { intensity } => first.map(|cell| Cell { intensity, ..cell }),
                         BeamOutcome::Medium { range_m, intensity, class } => {

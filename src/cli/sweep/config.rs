@@ -267,7 +267,8 @@ fn weather_axis(table: &BTreeMap<String, toml::Value>, source: &str) -> anyhow::
         bail!("{source}: `[weather]`: give `kind` and the values of exactly one of its parameters");
     };
     let field = format!("weather.{name}");
-    let raw: RawValues = toml::Value::clone(raw).try_into().with_context(|| format!("{source}: `{field}`: a list or a range table"))?;
+    let raw: RawValues =
+        toml::Value::clone(raw).try_into().with_context(|| format!("{source}: `{field}`: a list or a range table"))?;
     let values = expand(&field, &raw, source)?;
     for v in &values {
         sim::effects::weather::Weather::parse(&format!("{kind}:{name}={v}"))

@@ -164,7 +164,8 @@ impl Space {
 
     /// The weather of configuration `c` (`None` when the sweep has no weather axis).
     pub fn weather(&self, c: &Configuration) -> anyhow::Result<Option<sim::effects::weather::Weather>> {
-        let Some((name, v)) = self.params(c).find(|(name, _)| name.split('.').next() == Some(super::config::WEATHER_AXIS))
+        let Some((name, v)) =
+            self.params(c).find(|(name, _)| name.split('.').next() == Some(super::config::WEATHER_AXIS))
         else {
             return Ok(None);
         };

@@ -58,6 +58,9 @@ pub struct FogTable {
     profile: Vec<(f64, f64)>,
 }
 
+/// Tables built so far, by (visibility bits, intensity reference bits, minimum range bits).
+type TableCache = HashMap<(u64, u32, u32), Arc<FogTable>>;
+
 /// Target-range step of the table, m.
 const STEP_M: f64 = 0.1;
 /// The table's last target range, m: beyond `R_fog + c tau_H` nothing changes.
@@ -129,7 +132,7 @@ impl FogTable {
 
     /// The table for `visibility_m` and `m`, built once per process and shared.
     pub fn cached(visibility_m: f64, m: &Measurement) -> Arc<Self> {
-        static CACHE: OnceLock<Mutex<HashMap<(u64, u32, u32), Arc<FogTable>>>> = OnceLock::new();
+        static CACHE: OnceLock<Mutex<TableCache>> = OnceLock::new();
         let key = (visibility_m.to_bits(), m.intensity_reference_m.to_bits(), m.min_range_m.to_bits());
         let mut cache = CACHE.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
         Arc::clone(cache.entry(key).or_insert_with(|| Arc::new(Self::new(visibility_m, m))))

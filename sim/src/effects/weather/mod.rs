@@ -92,7 +92,9 @@ impl Weather {
         let one = |name: &str| -> Result<f64> {
             match fields.as_slice() {
                 [(k, v)] if *k == name => Ok(*v),
-                [(k, _)] => Err(SimError::invalid(format!("weather.{k}"), "an unknown field", format!("{kind} takes {name}"))),
+                [(k, _)] => {
+                    Err(SimError::invalid(format!("weather.{k}"), "an unknown field", format!("{kind} takes {name}")))
+                }
                 _ => Err(SimError::invalid("weather", spec, format!("{kind}:{name}=VALUE"))),
             }
         };
@@ -309,9 +311,10 @@ mod tests {
         let key = BeamKey { seed: 1, frame: 0, sensor: 0, ring: 0, column: 0 };
         // P_min = 0.1 (12 / 120)^2 = 1e-3: a 10 % target at normal incidence at 120 m is right on it.
         assert!((w.threshold() - 1e-3).abs() < 1e-9);
-        assert_eq!(w.beam(Some((50.0, 0.5 * (12.0f32 / 50.0).powi(2))), &key), BeamOutcome::Target {
-            intensity: 0.5 * (12.0f32 / 50.0).powi(2)
-        });
+        assert_eq!(
+            w.beam(Some((50.0, 0.5 * (12.0f32 / 50.0).powi(2))), &key),
+            BeamOutcome::Target { intensity: 0.5 * (12.0f32 / 50.0).powi(2) }
+        );
         assert_eq!(w.beam(Some((100.0, 0.05 * (12.0f32 / 100.0).powi(2))), &key), BeamOutcome::Lost);
         assert_eq!(w.beam(None, &key), BeamOutcome::Lost);
     }

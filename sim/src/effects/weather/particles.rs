@@ -15,9 +15,10 @@
 //! - **Per beam**: the particles that could beat the beam's floor (the threshold, or the target's
 //!   power when it is stronger) form a Poisson process along the beam, of rate
 //!   `A(R) int_{D_min(R)} N(D) dD` per metre (`A` the beam's cross-section). A table holds its
-//!   cumulative rate for floors on a factor-sqrt(2) ladder, so a beam draws only the few particles
-//!   that can matter (thinning keeps it exact), and the strongest one that beats the floor is the
-//!   medium's return.
+//!   cumulative rate for floors on a factor-sqrt(2) ladder; a beam draws the ladder band of its
+//!   strongest particle directly and only the one to few particles in it
+//!   ([`ParticleTable::strongest`]), and the strongest one that beats the floor is the medium's
+//!   return.
 
 use rand::RngExt;
 
@@ -90,7 +91,7 @@ impl Particles {
 /// Floors on the ladder, from the detection threshold up by factors of sqrt(2).
 const LEVELS: usize = 48;
 /// Range step of the table, m.
-const STEP_M: f64 = 0.25;
+const STEP_M: f64 = 0.1;
 
 /// The cumulative rate of particles that could beat each floor, per sensor.
 #[derive(Debug)]
@@ -102,9 +103,13 @@ pub struct ParticleTable {
     divergence_rad: f64,
     min_range_m: f64,
     max_range_m: f64,
-    /// `cumulative[level][k]`: expected particles in `[min_range, min_range + k STEP)` that could
-    /// beat floor `level`.
-    cumulative: Vec<Vec<f64>>,
+    /// `by_reach[k][level]`: expected particles in `[min_range, min_range + k STEP)` that could
+    /// beat floor `level` (a beam reads one row; `level = LEVELS` is 0).
+    by_reach: Vec<[f64; LEVELS + 1]>,
+    /// `exp(-by_reach[k][level])`: the chance that none does.
+    survival: Vec<[f64; LEVELS + 1]>,
+    /// The ladder's floors, `level_floor(0 ..= LEVELS)`.
+    floors: [f64; LEVELS + 1],
 }
 
 impl ParticleTable {
@@ -118,25 +123,28 @@ impl ParticleTable {
             divergence_rad: f64::from(m.beam_divergence_rad),
             min_range_m: f64::from(m.min_range_m).max(super::fog::OVERLAP_M.0),
             max_range_m: f64::from(m.max_range_m),
-            cumulative: Vec::new(),
+            by_reach: Vec::new(),
+            survival: Vec::new(),
+            floors: [0.0; LEVELS + 1],
         };
+        for (level, f) in t.floors.iter_mut().enumerate() {
+            *f = t.p_min * 2f64.powf(level as f64 / 2.0);
+        }
         let steps = ((t.max_range_m - t.min_range_m) / STEP_M).ceil().max(1.0) as usize;
-        t.cumulative = (0..LEVELS)
-            .map(|level| {
-                let floor = t.level_floor(level);
-                let mut acc = vec![0.0; steps + 1];
-                for k in 0..steps {
-                    let r = t.min_range_m + (k as f64 + 0.5) * STEP_M;
-                    acc[k + 1] = acc[k] + t.rate(r, floor) * STEP_M;
-                }
-                acc
-            })
-            .collect();
+        t.by_reach = vec![[0.0; LEVELS + 1]; steps + 1];
+        for level in 0..LEVELS {
+            let floor = t.floors[level];
+            for k in 0..steps {
+                let r = t.min_range_m + (k as f64 + 0.5) * STEP_M;
+                t.by_reach[k + 1][level] = t.by_reach[k][level] + t.rate(r, floor) * STEP_M;
+            }
+        }
+        t.survival = t.by_reach.iter().map(|row| row.map(|m| (-m).exp())).collect();
         t
     }
 
     fn level_floor(&self, level: usize) -> f64 {
-        self.p_min * 2f64.powf(level as f64 / 2.0)
+        self.floors.get(level).copied().unwrap_or_else(|| self.p_min * 2f64.powf(level as f64 / 2.0))
     }
 
     /// Beam diameter at `r`, m.
@@ -166,53 +174,104 @@ impl ParticleTable {
         area * self.particles.count_above(d_min)
     }
 
-    /// The power of a particle of diameter `d_mm` at `r`.
-    fn power(&self, r: f64, d_mm: f64) -> f64 {
-        let share = (d_mm * 1e-3 / self.beam_m(r)).powi(2).min(1.0);
-        share * self.full_power(r)
+    /// The expected number of particles out to `reach_m` that beat ladder floor `level`.
+    #[cfg(test)]
+    fn mean(&self, level: usize, reach_m: f64) -> f64 {
+        let reach = (reach_m - self.min_range_m) / STEP_M;
+        let last = self.by_reach.len() - 1;
+        let k = (reach as usize).min(last);
+        let frac = (reach - k as f64).min(1.0);
+        let (a, b) = (self.by_reach[k][level], self.by_reach[(k + 1).min(last)][level]);
+        a + frac * (b - a)
     }
 
     /// The strongest particle in a beam out to `reach_m` that is at least `floor` strong:
-    /// `(range, power, class)`. `_alpha` is the medium's extinction (the table's own).
-    pub(super) fn strongest(&self, reach_m: f32, floor: f32, _alpha: f32, key: &BeamKey) -> Option<(f32, f32, SemanticClass)> {
+    /// `(range, power, class)`.
+    ///
+    /// The particles beating ladder floor `L` are a Poisson process whose mean `m_L` falls with
+    /// `L`, nested in those beating `L - 1`. The strongest particle lies in the band of the highest
+    /// level with any particle: with one uniform `u`, that is the highest `L` with
+    /// `exp(-m_L) < u` (`m_L > -ln u`), found by bisection. Its band holds a zero-truncated
+    /// Poisson number of particles (mean `m_L - m_(L+1)`), each placed by the band's cumulative
+    /// rate along the beam and sized between the two floors' smallest diameters there; the
+    /// strongest of them is the return, if it beats `floor` itself (floors between ladder steps).
+    /// Exact, and a beam draws one to a few particles however many are in it.
+    pub(super) fn strongest(
+        &self,
+        reach_m: f32,
+        floor: f32,
+        _alpha: f32,
+        key: &BeamKey,
+    ) -> Option<(f32, f32, SemanticClass)> {
         let floor = f64::from(floor);
-        // The highest ladder floor at or below the beam's floor.
-        let level = ((2.0 * (floor / self.p_min).log2()).floor().max(0.0) as usize).min(LEVELS - 1);
-        let row = &self.cumulative[level];
         let reach = (f64::from(reach_m).min(self.max_range_m) - self.min_range_m) / STEP_M;
         if reach <= 0.0 {
             return None;
         }
-        let k = (reach as usize).min(row.len() - 1);
-        let frac = (reach - k as f64).min(1.0);
-        let mean = row[k] + frac * (row.get(k + 1).copied().unwrap_or(row[k]) - row[k]);
-        if mean <= 0.0 {
+        // The highest ladder floor at or below the beam's floor.
+        let base = self.floors[..LEVELS].partition_point(|&f| f <= floor).saturating_sub(1);
+        let last = self.by_reach.len() - 1;
+        let k0 = (reach as usize).min(last);
+        let frac = (reach - k0 as f64).min(1.0);
+        let (s_a, s_b) = (&self.survival[k0], &self.survival[(k0 + 1).min(last)]);
+        let survival = |level: usize| s_a[level] + frac * (s_b[level] - s_a[level]);
+        let mut rng = key.rng(Purpose::Weather);
+        // One uniform: particles beat floor L iff u > P(none does) = S_L (S grows with L).
+        let u = rng.random::<f64>();
+        if survival(base) >= u {
             return None;
         }
-        let mut rng = key.rng(Purpose::Weather);
-        // Poisson count (mean below a few tens here), by multiplication of uniforms.
-        let limit = (-mean).exp();
-        let mut count = 0usize;
-        let mut prod: f64 = rng.random();
-        while prod > limit && count < 1000 {
-            count += 1;
-            prod *= rng.random::<f64>();
+        let (mut lo, mut hi) = (base, LEVELS); // S_lo < u; S_hi >= u (beyond the ladder: 1)
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if survival(mid) < u { lo = mid } else { hi = mid }
         }
-        let ladder = self.level_floor(level);
+        let level = lo;
+        let (m_a, m_b) = (&self.by_reach[k0], &self.by_reach[(k0 + 1).min(last)]);
+        let mean = |level: usize| m_a[level] + frac * (m_b[level] - m_a[level]);
+        let band = (mean(level) - mean(level + 1)).max(0.0);
+        // The band's count given at least one: inverse CDF of the zero-truncated Poisson, with
+        // P(0) = exp(-band) = S_L / S_(L+1).
+        let count = {
+            let p0 = (survival(level) / survival(level + 1)).min(1.0);
+            let target = p0 + rng.random::<f64>() * (1.0 - p0);
+            let (mut k, mut pk, mut cdf) = (0usize, p0, p0);
+            while cdf < target && k < 64 {
+                k += 1;
+                pk *= band / k as f64;
+                cdf += pk;
+            }
+            k.max(1)
+        };
+        let (lower, upper) = (self.level_floor(level), self.level_floor(level + 1));
         let l = self.particles.lambda_per_mm;
+        let last = (k0 + 1).min(last);
+        let band_at = |j: usize| self.by_reach[j][level] - self.by_reach[j][level + 1];
+        let total = band;
         let mut best: Option<(f64, f64)> = None;
         for _ in 0..count {
-            // Its place: the inverse of the cumulative rate.
-            let u = rng.random::<f64>() * mean;
-            let j = row.partition_point(|&c| c < u).clamp(1, row.len() - 1);
-            let (c0, c1) = (row[j - 1], row[j]);
-            let t = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
-            let r = self.min_range_m + (j as f64 - 1.0 + t) * STEP_M;
-            // Its size: the exponential above the ladder floor's smallest diameter, truncated.
-            let Some(d_min) = self.d_min_mm(r, ladder) else { continue };
-            let span = 1.0 - (-l * (self.particles.d_max_mm - d_min).max(0.0)).exp();
-            let d = d_min - (1.0 - rng.random::<f64>() * span).ln() / l;
-            let p = self.power(r, d);
+            // Its place: the inverse of the band's cumulative rate (non-decreasing along the beam).
+            let w = rng.random::<f64>() * total;
+            let (mut a, mut b) = (0usize, last);
+            while b - a > 1 {
+                let mid = (a + b) / 2;
+                if band_at(mid) < w { a = mid } else { b = mid }
+            }
+            let (c0, c1) = (band_at(a), band_at(b));
+            let t = if c1 > c0 { ((w - c0) / (c1 - c0)).clamp(0.0, 1.0) } else { 0.5 };
+            let r = (self.min_range_m + (a as f64 + t) * STEP_M).min(f64::from(reach_m));
+            // Its size: the exponential between the two floors' smallest diameters there.
+            let full = self.full_power(r);
+            if full < lower {
+                continue;
+            }
+            let beam_mm = self.beam_m(r) * 1e3;
+            let d_lo = beam_mm * (lower / full).sqrt();
+            let d_hi = if full >= upper { beam_mm * (upper / full).sqrt() } else { f64::INFINITY };
+            let d_hi = d_hi.min(self.particles.d_max_mm);
+            let span = 1.0 - (-l * (d_hi - d_lo).max(0.0)).exp();
+            let d = d_lo - (1.0 - rng.random::<f64>() * span).ln() / l;
+            let p = (d / beam_mm).powi(2).min(1.0) * full;
             if p >= floor && best.is_none_or(|(_, bp)| p > bp) {
                 best = Some((r, p));
             }
@@ -250,7 +309,7 @@ mod tests {
         let m = hdl();
         let t = ParticleTable::new(&Particles::snow(2.0), &m);
         let floor = t.p_min as f32;
-        let expected_any = 1.0 - (-t.cumulative[0][((30.0 - t.min_range_m) / STEP_M) as usize]).exp();
+        let expected_any = 1.0 - (-t.mean(0, 30.0)).exp();
         let n = 20_000;
         let seen = (0..n)
             .filter(|&c| {
@@ -269,5 +328,35 @@ mod tests {
             .count() as f64
             / n as f64;
         assert!(strong < 0.5 * seen, "{strong} vs {seen}");
+    }
+
+    /// Floors between the ladder's steps: the share of beams whose strongest particle beats the
+    /// floor is `1 - exp(-m)`, `m` the rate of such particles integrated along the beam directly.
+    #[test]
+    fn the_strongest_particle_beats_any_floor_at_its_rate() {
+        let m = hdl();
+        for particles in [Particles::snow(1.0), Particles::rain(30.0)] {
+            let t = ParticleTable::new(&particles, &m);
+            for (floor, reach) in [(t.p_min * 2f64.powf(0.3), 40.0), (t.p_min * 37.0, 25.0), (0.02, 12.0)] {
+                let steps = ((reach - t.min_range_m) / (STEP_M / 10.0)) as usize;
+                let mean: f64 = (0..steps)
+                    .map(|k| t.rate(t.min_range_m + (k as f64 + 0.5) * STEP_M / 10.0, floor) * STEP_M / 10.0)
+                    .sum();
+                let expected = 1.0 - (-mean).exp();
+                let n = 20_000;
+                let seen = (0..n)
+                    .filter(|&c| {
+                        let key = BeamKey { seed: 5, frame: 1, sensor: 0, ring: 2, column: c };
+                        t.strongest(reach as f32, floor as f32, 0.0, &key).is_some_and(|(r, p, _)| {
+                            assert!(f64::from(p) >= floor * 0.999 && f64::from(r) <= reach + 1e-3);
+                            true
+                        })
+                    })
+                    .count() as f64
+                    / n as f64;
+                eprintln!("{:?} floor {floor}: {seen} vs {expected}", particles.class);
+                assert!((seen - expected).abs() < 0.015, "{:?} floor {floor}: {seen} vs {expected}", particles.class);
+            }
+        }
     }
 }
