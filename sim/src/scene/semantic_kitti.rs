@@ -4,10 +4,12 @@
 
 /// Every SemanticKITTI label id (our classes use the same ids) with its name, BGR colour and
 /// learning class, as SemanticKITTI's `semantic-kitti.yaml` has them, plus our bush class 73
-/// (learning class 15, vegetation; its colour [`SemanticClass::BUSH`]'s). The ids our scenes do not
+/// (learning class 15, vegetation; its colour [`SemanticClass::BUSH`]'s) and our weather classes
+/// fog 150, rain 151 and snow 152 (learning class 0, ignored, as SemanticKITTI's outliers; returns
+/// from the air, [`crate::effects::weather`]). The ids our scenes do not
 /// make (bicycle, bus, moving-*, ...) are listed too: the evaluation scripts name every learning
 /// class through `labels[learning_map_inv[c]]`.
-pub const CLASSES: [(u16, &str, [u8; 3], u8); 35] = [
+pub const CLASSES: [(u16, &str, [u8; 3], u8); 38] = [
     (0, "unlabeled", [0, 0, 0], 0),
     (1, "outlier", [0, 0, 255], 0),
     (10, "car", [245, 150, 100], 1),
@@ -43,6 +45,9 @@ pub const CLASSES: [(u16, &str, [u8; 3], u8); 35] = [
     (257, "moving-bus", [250, 80, 100], 5),
     (258, "moving-truck", [180, 30, 80], 4),
     (259, "moving-other-vehicle", [255, 0, 0], 5),
+    (150, "fog", [200, 200, 200], 0),
+    (151, "rain", [255, 160, 90], 0),
+    (152, "snow", [255, 250, 240], 0),
 ];
 
 /// SemanticKITTI's learning classes and the label id each stands for (`learning_map_inv`).
