@@ -243,9 +243,12 @@ impl SensorWeather {
             Medium::Fog(table) => table.strongest(reach_m, floor, key),
             Medium::Particles(table) => table.strongest(reach_m, floor, self.alpha_per_m, key),
         };
+        // Quantised, the medium's return must still lie in front of the target.
+        let medium = medium
+            .map(|(range_m, power, class)| (quantise(range_m, self.m.range_quantum_m), power, class))
+            .filter(|&(range_m, _, _)| target.is_none_or(|(r, _)| range_m < r));
         match (medium, hard) {
             (Some((range_m, power, class)), _) => {
-                let range_m = quantise(range_m, self.m.range_quantum_m);
                 BeamOutcome::Medium { range_m, intensity: saturate(&self.m, power, range_m), class }
             }
             (None, Some((_, intensity, _))) => BeamOutcome::Target { intensity },

@@ -273,7 +273,10 @@ impl ParticleTable {
             let a = last_true(0, last, |j| band_at(j) < w);
             let (c0, c1) = (band_at(a), band_at(a + 1));
             let t = if c1 > c0 { ((w - c0) / (c1 - c0)).clamp(0.0, 1.0) } else { 0.5 };
-            let r = (self.min_range_m + (a as f64 + t) * STEP_M).min(f64::from(reach_m));
+            let r = self.min_range_m + (a as f64 + t) * STEP_M;
+            if r >= f64::from(reach_m) {
+                continue; // at the target: its pulse and the target's are one
+            }
             // Its size: the exponential between the two floors' smallest diameters there.
             let full = self.full_power_fast(r);
             if full < lower {
