@@ -6,9 +6,15 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_groundtruth");
+mod common;
+
+use common::{err, ok, run, s};
+
+/// A fresh scratch directory for this file's test `name`.
+fn tmp(name: &str) -> PathBuf {
+    common::tmp("dataset", name)
+}
 
 /// Two short sequences on the built-in flat scene: straight at 10 m/s, and an arc at 10 m/s and
 /// 20 deg/s with the sensor 0.1 m higher.
@@ -33,31 +39,6 @@ frames = 4
 speed_m_per_s = 10.0
 yaw_rate_deg_per_s = 20.0
 "#;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("gt-dataset-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn ok(out: Output) -> String {
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn err(out: Output) -> String {
-    assert!(!out.status.success(), "accepted: {}", String::from_utf8_lossy(&out.stdout));
-    String::from_utf8(out.stderr).unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// Every file under `dir` (relative path -> bytes).
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {

@@ -6,9 +6,15 @@
 //!   the protocols, and every bad input refused naming the file or flag, with nothing written.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_groundtruth");
+mod common;
+
+use common::{err, ok, run, s};
+
+/// A fresh scratch directory for this file's test `name`.
+fn tmp(name: &str) -> PathBuf {
+    common::tmp("learned", name)
+}
 
 /// A small training set: four scene families, two rigs, randomised mounts and noise, 8 sequences
 /// of 2 frames, 20 trees.
@@ -52,31 +58,6 @@ rig = "os1-64-roof"
 frames = 2
 speed_m_per_s = 8.0
 "#;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("gt-learned-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn ok(out: Output) -> String {
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn err(out: Output) -> String {
-    assert!(!out.status.success(), "accepted: {}", String::from_utf8_lossy(&out.stdout));
-    String::from_utf8(out.stderr).unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

@@ -3,33 +3,14 @@
 //! fog visibility, and bad specs refused with the field and its range before anything is written.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_groundtruth");
+mod common;
 
+use common::{err, ok, run, s};
+
+/// A fresh scratch directory for this file's test `name`.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("gt-weather-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn ok(out: Output) -> String {
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn err(out: Output) -> String {
-    assert!(!out.status.success(), "accepted: {}", String::from_utf8_lossy(&out.stdout));
-    String::from_utf8(out.stderr).unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::tmp("weather", name)
 }
 
 /// Label ids of a SemanticKITTI `.label` file and how often each occurs.

@@ -77,20 +77,20 @@ fn read_bag(py: Python<'_>, path: &Path, topic: Option<String>) -> PyResult<Vec<
         })
         .map_err(|e| value_error("path", e))?;
     let name = path.display().to_string();
-    Ok(clouds
-        .into_iter()
-        .map(|cloud| {
-            let frame = sim::scan::Frame {
-                index: 0,
-                start_time_s: 0.0,
-                vehicle_pose: Default::default(),
-                world_from_vehicle: glam::Affine3A::IDENTITY,
-                cloud,
-            };
-            let rig = sim::Rig { name: String::new(), sensors: Vec::new() };
-            Frame { scan: Arc::new(Scan::from_frames(vec![frame], &name, rig)), k: 0 }
-        })
-        .collect())
+    Ok(clouds.into_iter().map(|cloud| frame_of(cloud, &name)).collect())
+}
+
+/// A cloud read from a file as a one-frame scan named `name` (no rig, identity pose).
+fn frame_of(cloud: sim::OrderedCloud, name: &str) -> Frame {
+    let frame = sim::scan::Frame {
+        index: 0,
+        start_time_s: 0.0,
+        vehicle_pose: Default::default(),
+        world_from_vehicle: glam::Affine3A::IDENTITY,
+        cloud,
+    };
+    let rig = sim::Rig { name: String::new(), sensors: Vec::new() };
+    Frame { scan: Arc::new(Scan::from_frames(vec![frame], name, rig)), k: 0 }
 }
 
 /// Reads one point-cloud file (see [`read`]).
@@ -121,16 +121,7 @@ fn read_file(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
             )
         })?
         .map_err(sim_error)?;
-    let frame = sim::scan::Frame {
-        index: 0,
-        start_time_s: 0.0,
-        vehicle_pose: Default::default(),
-        world_from_vehicle: glam::Affine3A::IDENTITY,
-        cloud,
-    };
-    let rig = sim::Rig { name: String::new(), sensors: Vec::new() };
-    let name = path.display().to_string();
-    Ok(Frame { scan: Arc::new(Scan::from_frames(vec![frame], &name, rig)), k: 0 })
+    Ok(frame_of(cloud, &path.display().to_string()))
 }
 
 /// Writes `frame` to `path` in `format` (`pcd`, `pcd-ascii`, `ply`, `kitti`, `las`; default: from

@@ -58,7 +58,7 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
     let prepared = sim::scan::PreparedScene::new(&scene.mesh, config.backend)?;
     let scanner = Scanner::with_prepared(&scene.mesh, &rig, config.clone(), &prepared)?;
     let setup_s = t0.elapsed().as_secs_f64();
-    let weathers = args
+    let mut weathers = args
         .weather
         .iter()
         .map(|spec| {
@@ -72,13 +72,13 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
             Ok((w, s, f64::INFINITY, 0usize))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut weathers = weathers;
 
     let rows = scanner.rows();
     let all_rays: Vec<_> = (0..rows).map(|r| scanner.row_rays(0, r).rays).collect();
     let rays: usize = all_rays.iter().map(Vec::len).sum();
     let (mut bare_s, mut full_s) = (f64::INFINITY, f64::INFINITY);
     let mut cloud = sim::OrderedCloud::default();
+    let mut returns = 0;
     for _ in 0..args.frames {
         let t = Instant::now();
         let hits: usize = all_rays
@@ -94,22 +94,22 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
         let t = Instant::now();
         scanner.frame_into(0, &mut cloud);
         full_s = full_s.min(t.elapsed().as_secs_f64());
-        for (_, s, best, returns) in &mut weathers {
+        returns = cloud.returns();
+        for (_, s, best, weather_returns) in &mut weathers {
             let t = Instant::now();
             s.frame_into(0, &mut cloud);
             *best = best.min(t.elapsed().as_secs_f64());
-            *returns = cloud.returns();
+            *weather_returns = cloud.returns();
         }
-        scanner.frame_into(0, &mut cloud);
     }
     let weather: Vec<serde_json::Value> = weathers
         .iter()
-        .map(|(w, _, best, returns)| {
+        .map(|(w, _, best, weather_returns)| {
             serde_json::json!({
                 "weather": w.spec(),
                 "full_frame_ms": best * 1e3,
                 "added": best / full_s - 1.0,
-                "returns": returns,
+                "returns": weather_returns,
             })
         })
         .collect();
@@ -121,7 +121,7 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
         "threads": rayon::current_num_threads(),
         "speed_m_per_s": args.speed,
         "rays": rays,
-        "returns": cloud.returns(),
+        "returns": returns,
         "setup_s": setup_s,
         "bare_cast_ms": bare_s * 1e3,
         "full_frame_ms": full_s * 1e3,

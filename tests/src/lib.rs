@@ -40,3 +40,26 @@ pub fn classify(frames: Vec<Frame>, method: &str) -> Scenario {
     }
     Scenario { frames, decisions, eval }
 }
+
+/// Every field of every cell of `c` as bits: two clouds are the same bytes iff these are equal.
+pub fn cloud_bits(c: &sim::OrderedCloud) -> Vec<u64> {
+    let mut v: Vec<u64> = Vec::new();
+    v.extend(c.point_in_vehicle.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
+    v.extend(c.normal.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
+    v.extend(c.range_m.iter().map(|x| u64::from(x.to_bits())));
+    v.extend(c.intensity.iter().map(|x| u64::from(x.to_bits())));
+    v.extend(c.time_s.iter().map(|x| x.to_bits()));
+    v.extend(c.ring.iter().map(|&x| u64::from(x)));
+    v.extend(c.column.iter().map(|&x| u64::from(x)));
+    v.extend(c.sensor.iter().map(|&x| u64::from(x)));
+    v.extend(c.echo.iter().map(|&x| u64::from(x)));
+    v.extend(c.label.iter().map(|x| u64::from(x.0)));
+    v.extend(c.instance.iter().map(|&x| u64::from(x)));
+    v.extend(c.ground.iter().map(|&x| u64::from(x)));
+    v
+}
+
+/// Scans `mesh` with `rig` on a pool of `threads` worker threads.
+pub fn scan_with_threads(threads: usize, mesh: &sim::SceneMesh, rig: &sim::Rig, config: &ScanConfig) -> Vec<Frame> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| scan(mesh, rig, config).unwrap())
+}

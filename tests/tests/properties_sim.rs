@@ -9,13 +9,14 @@
 
 use glam::{Affine3A, Vec3};
 use groundtruth_scenario::strategies::config;
+use gt_tests::{cloud_bits, scan_with_threads};
 use parry3d::math::Pose;
 use parry3d::query::{Ray, RayCast};
 use parry3d::shape::{Ball, Cuboid};
 use proptest::prelude::*;
 use sim::rig::{Mount, Rig};
-use sim::scan::{Frame, ScanConfig, scan};
-use sim::{OrderedCloud, SceneMesh, SemanticClass, Surface};
+use sim::scan::{ScanConfig, scan};
+use sim::{SceneMesh, SemanticClass, Surface};
 
 /// Sphere tessellation: 64 subdivisions around, 32 from pole to pole.
 const SPHERE_THETA: u32 = 64;
@@ -58,27 +59,6 @@ impl Shapes {
         push_trimesh(&mut mesh, cuboid.to_trimesh(), c + shift, Surface::object(SemanticClass::BUILDING, 2));
         mesh
     }
-}
-
-fn bits(c: &OrderedCloud) -> Vec<u64> {
-    let mut v: Vec<u64> = Vec::new();
-    v.extend(c.point_in_vehicle.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
-    v.extend(c.normal.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
-    v.extend(c.range_m.iter().map(|x| u64::from(x.to_bits())));
-    v.extend(c.intensity.iter().map(|x| u64::from(x.to_bits())));
-    v.extend(c.time_s.iter().map(|x| x.to_bits()));
-    v.extend(c.ring.iter().map(|&x| u64::from(x)));
-    v.extend(c.column.iter().map(|&x| u64::from(x)));
-    v.extend(c.sensor.iter().map(|&x| u64::from(x)));
-    v.extend(c.echo.iter().map(|&x| u64::from(x)));
-    v.extend(c.label.iter().map(|x| u64::from(x.0)));
-    v.extend(c.instance.iter().map(|&x| u64::from(x)));
-    v.extend(c.ground.iter().map(|&x| u64::from(x)));
-    v
-}
-
-fn scan_with_threads(threads: usize, mesh: &SceneMesh, rig: &Rig, config: &ScanConfig) -> Vec<Frame> {
-    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| scan(mesh, rig, config).unwrap())
 }
 
 proptest! {
@@ -195,7 +175,7 @@ proptest! {
         let one = scan_with_threads(1, &scene.mesh, &rig, &config);
         let two = scan_with_threads(2, &scene.mesh, &rig, &config);
         for (a, b) in one.iter().zip(&two) {
-            prop_assert!(bits(&a.cloud) == bits(&b.cloud), "frame {} differs", a.index);
+            prop_assert!(cloud_bits(&a.cloud) == cloud_bits(&b.cloud), "frame {} differs", a.index);
         }
     }
 

@@ -14,35 +14,14 @@
 
 use groundtruth_scenario::strategies::{self, config};
 use groundtruth_scenario::{Region, RegionScore, Scan, Scenario, Weather};
+use gt_tests::{cloud_bits, scan_with_threads};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
-use sim::cloud::OrderedCloud;
 use sim::rig::Rig;
-use sim::scan::{Frame, ScanConfig, scan};
+use sim::scan::ScanConfig;
 use sim::scene::SemanticClass;
 
 const METHODS: [&str; 5] = ["nitsch", "ransac", "grid", "mcdaniel", "learned"];
-
-fn bits(c: &OrderedCloud) -> Vec<u64> {
-    let mut v: Vec<u64> = Vec::new();
-    v.extend(c.point_in_vehicle.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
-    v.extend(c.normal.iter().flat_map(|p| p.to_array().map(|x| u64::from(x.to_bits()))));
-    v.extend(c.range_m.iter().map(|x| u64::from(x.to_bits())));
-    v.extend(c.intensity.iter().map(|x| u64::from(x.to_bits())));
-    v.extend(c.time_s.iter().map(|x| x.to_bits()));
-    v.extend(c.label.iter().map(|x| u64::from(x.0)));
-    v.extend(c.instance.iter().map(|&x| u64::from(x)));
-    v.extend(c.ground.iter().map(|&x| u64::from(x)));
-    v
-}
-
-fn scan_with_threads(threads: usize, scene: &scenes::Scene, rig: &Rig, config: &ScanConfig) -> Vec<Frame> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(|| scan(&scene.mesh, rig, config).unwrap())
-}
 
 fn road_scene() -> impl Strategy<Value = &'static str> {
     prop::sample::select(vec!["city", "highway", "rural"])
@@ -120,10 +99,10 @@ proptest! {
         let scene = scenes::load_bundled(scene, seed).unwrap();
         let rig = Rig::preset("vlp16-roof").unwrap();
         let config = ScanConfig { seed, frames: 2, speed_m_per_s: 8.0, ego_z_m: scene.ego_ground_z_m, weather: Some(weather), ..ScanConfig::default() };
-        let one = scan_with_threads(1, &scene, &rig, &config);
-        let two = scan_with_threads(2, &scene, &rig, &config);
+        let one = scan_with_threads(1, &scene.mesh, &rig, &config);
+        let two = scan_with_threads(2, &scene.mesh, &rig, &config);
         for (a, b) in one.iter().zip(&two) {
-            prop_assert!(bits(&a.cloud) == bits(&b.cloud), "frame {} differs ({weather:?})", a.index);
+            prop_assert!(cloud_bits(&a.cloud) == cloud_bits(&b.cloud), "frame {} differs ({weather:?})", a.index);
         }
     }
 

@@ -39,7 +39,8 @@ pub fn extinction_per_m(visibility_m: f64) -> f64 {
     20f64.ln() / visibility_m
 }
 
-fn overlap(x: f64) -> f64 {
+/// The overlap of beam and receiver at range `x`: 0 below `OVERLAP_M.0`, 1 above `OVERLAP_M.1`.
+pub(super) fn overlap(x: f64) -> f64 {
     ((x - OVERLAP_M.0) / (OVERLAP_M.1 - OVERLAP_M.0)).clamp(0.0, 1.0)
 }
 

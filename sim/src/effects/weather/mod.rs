@@ -241,7 +241,7 @@ impl SensorWeather {
         let medium = match &self.medium {
             Medium::None => None,
             Medium::Fog(table) => table.strongest(reach_m, floor, key),
-            Medium::Particles(table) => table.strongest(reach_m, floor, self.alpha_per_m, key),
+            Medium::Particles(table) => table.strongest(reach_m, floor, key),
         };
         // Quantised, the medium's return must still lie in front of the target.
         let medium = medium

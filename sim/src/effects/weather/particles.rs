@@ -108,12 +108,7 @@ pub struct ParticleTable {
     by_reach: Vec<[f64; LEVELS + 1]>,
     /// `exp(-by_reach[k][level])`: the chance that none does.
     survival: Vec<[f64; LEVELS + 1]>,
-    /// `bands[level][k] = by_reach[k][level] - by_reach[k][level + 1]`, contiguous per level (a
-    /// particle's place is a bisection of one band).
-    bands: Vec<Vec<f64>>,
-    /// Two-way transmission at the table's step boundaries, `exp(-2 alpha r_k)`.
-    transmission: Vec<f64>,
-    /// The ladder's floors, `level_floor(0 ..= LEVELS)`.
+    /// The ladder's floors, `p_min 2^(level / 2)` for `level = 0 ..= LEVELS`.
     floors: [f64; LEVELS + 1],
 }
 
@@ -130,8 +125,6 @@ impl ParticleTable {
             max_range_m: f64::from(m.max_range_m),
             by_reach: Vec::new(),
             survival: Vec::new(),
-            bands: Vec::new(),
-            transmission: Vec::new(),
             floors: [0.0; LEVELS + 1],
         };
         for (level, f) in t.floors.iter_mut().enumerate() {
@@ -146,15 +139,8 @@ impl ParticleTable {
                 t.by_reach[k + 1][level] = t.by_reach[k][level] + t.rate(r, floor) * STEP_M;
             }
         }
-        t.transmission =
-            (0..=steps + 1).map(|k| (-2.0 * t.alpha * (t.min_range_m + k as f64 * STEP_M)).exp()).collect();
         t.survival = t.by_reach.iter().map(|row| row.map(|m| (-m).exp())).collect();
-        t.bands = (0..LEVELS).map(|level| t.by_reach.iter().map(|row| row[level] - row[level + 1]).collect()).collect();
         t
-    }
-
-    fn level_floor(&self, level: usize) -> f64 {
-        self.floors.get(level).copied().unwrap_or_else(|| self.p_min * 2f64.powf(level as f64 / 2.0))
     }
 
     /// Beam diameter at `r`, m.
@@ -164,19 +150,7 @@ impl ParticleTable {
 
     /// Power of a whole-beam return at `r` (a particle covering the beam).
     fn full_power(&self, r: f64) -> f64 {
-        let xi = ((r - super::fog::OVERLAP_M.0) / (super::fog::OVERLAP_M.1 - super::fog::OVERLAP_M.0)).clamp(0.0, 1.0);
-        self.particles.reflectance * (self.r_ref / r).powi(2) * xi * (-2.0 * self.alpha * r).exp()
-    }
-
-    /// [`Self::full_power`] with the two-way transmission interpolated from the table's steps
-    /// (relative error below `(alpha STEP)^2 / 8`, 1e-9 in snow of 20 mm/h).
-    fn full_power_fast(&self, r: f64) -> f64 {
-        let x = ((r - self.min_range_m) / STEP_M).max(0.0);
-        let k = (x as usize).min(self.transmission.len() - 2);
-        let f = x - k as f64;
-        let t2 = self.transmission[k] + f * (self.transmission[k + 1] - self.transmission[k]);
-        let xi = ((r - super::fog::OVERLAP_M.0) / (super::fog::OVERLAP_M.1 - super::fog::OVERLAP_M.0)).clamp(0.0, 1.0);
-        self.particles.reflectance * (self.r_ref / r).powi(2) * xi * t2
+        self.particles.reflectance * (self.r_ref / r).powi(2) * super::fog::overlap(r) * (-2.0 * self.alpha * r).exp()
     }
 
     /// The smallest diameter (mm) whose return at `r` reaches `floor`, or `None` when none does.
@@ -217,13 +191,7 @@ impl ParticleTable {
     /// rate along the beam and sized between the two floors' smallest diameters there; the
     /// strongest of them is the return, if it beats `floor` itself (floors between ladder steps).
     /// Exact, and a beam draws one to a few particles however many are in it.
-    pub(super) fn strongest(
-        &self,
-        reach_m: f32,
-        floor: f32,
-        _alpha: f32,
-        key: &BeamKey,
-    ) -> Option<(f32, f32, SemanticClass)> {
+    pub(super) fn strongest(&self, reach_m: f32, floor: f32, key: &BeamKey) -> Option<(f32, f32, SemanticClass)> {
         let floor = f64::from(floor);
         let reach = (f64::from(reach_m).min(self.max_range_m) - self.min_range_m) / STEP_M;
         if reach <= 0.0 {
@@ -260,11 +228,10 @@ impl ParticleTable {
             }
             k.max(1)
         };
-        let (lower, upper) = (self.level_floor(level), self.level_floor(level + 1));
+        let (lower, upper) = (self.floors[level], self.floors[level + 1]);
         let l = self.particles.lambda_per_mm;
         let last = (k0 + 1).min(last);
-        let band_row = &self.bands[level];
-        let band_at = |j: usize| band_row[j];
+        let band_at = |j: usize| self.by_reach[j][level] - self.by_reach[j][level + 1];
         let total = band;
         let mut best: Option<(f64, f64)> = None;
         for _ in 0..count {
@@ -278,7 +245,7 @@ impl ParticleTable {
                 continue; // at the target: its pulse and the target's are one
             }
             // Its size: the exponential between the two floors' smallest diameters there.
-            let full = self.full_power_fast(r);
+            let full = self.full_power(r);
             if full < lower {
                 continue;
             }
@@ -346,7 +313,7 @@ mod tests {
         let seen = (0..n)
             .filter(|&c| {
                 let key = BeamKey { seed: 3, frame: 0, sensor: 0, ring: 0, column: c };
-                t.strongest(30.0, floor, 0.0, &key).is_some()
+                t.strongest(30.0, floor, &key).is_some()
             })
             .count() as f64
             / n as f64;
@@ -355,7 +322,7 @@ mod tests {
         let strong = (0..n)
             .filter(|&c| {
                 let key = BeamKey { seed: 3, frame: 0, sensor: 0, ring: 0, column: c };
-                t.strongest(30.0, 0.05, 0.0, &key).is_some()
+                t.strongest(30.0, 0.05, &key).is_some()
             })
             .count() as f64
             / n as f64;
@@ -379,7 +346,7 @@ mod tests {
                 let seen = (0..n)
                     .filter(|&c| {
                         let key = BeamKey { seed: 5, frame: 1, sensor: 0, ring: 2, column: c };
-                        t.strongest(reach as f32, floor as f32, 0.0, &key).is_some_and(|(r, p, _)| {
+                        t.strongest(reach as f32, floor as f32, &key).is_some_and(|(r, p, _)| {
                             assert!(f64::from(p) >= floor * 0.999 && f64::from(r) <= reach + 1e-3);
                             true
                         })
