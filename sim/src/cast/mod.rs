@@ -2,6 +2,7 @@
 //! and the reference backend ([`ParryCaster`], parry3d). Both use the same watertight
 //! ray/triangle test ([`watertight`]), so a ray along a shared edge never slips through.
 
+mod beams;
 mod bvh;
 pub mod fixture;
 #[cfg(feature = "gpu")]
@@ -10,6 +11,7 @@ mod reference;
 pub mod watertight;
 mod wide4;
 
+pub use beams::{Beam, BeamSet, BeamSetError};
 pub use bvh::{BvhCaster, BvhLayout, BvhOptions};
 pub use reference::ParryCaster;
 
@@ -107,6 +109,15 @@ pub trait Caster: Send + Sync {
     fn cast_all_resident(&self, key: u64, rays: &[Ray]) -> Vec<Option<Hit>> {
         let _ = key;
         self.cast_all(rays)
+    }
+
+    /// Casts `beams` from each frame's poses (`poses`: [`BeamSet::poses_per_frame`] per frame,
+    /// frame after frame): the hits of every frame in turn, each in beam order. A device backend
+    /// keeps the beams on the device and makes the rays there (its rays may differ from the host's
+    /// in the last bits: [`crate::scan::AgreementContract`]); the default makes them on the host
+    /// ([`BeamSet::rays`]) and casts them with [`Caster::cast_all`].
+    fn cast_beams(&self, beams: &BeamSet, poses: &[glam::Affine3A]) -> Vec<Option<Hit>> {
+        self.cast_all(&beams.rays(poses))
     }
 
     /// Whether the backend wants a whole frame's rays per call ([`Caster::cast_all`]) rather than

@@ -34,11 +34,13 @@ use crate::sensor::{Measurement, ScanPattern};
 
 mod agreement;
 mod cells;
+mod pipeline;
 mod rays;
 mod row;
 
 pub use agreement::{Agreement, AgreementContract};
 use cells::{ExtraEcho, row_views};
+use pipeline::CastAhead;
 pub use rays::RowRays;
 use rays::{RowBeams, ShotTimes};
 use row::{RowScratch, TriangleRecord, triangle_records};
@@ -157,6 +159,9 @@ pub struct Scanner<'a> {
     /// For a standing vehicle and a caster that takes whole frames: the rays of every row in order,
     /// and the key under which the caster keeps them ([`Caster::cast_all_resident`]).
     static_ray_set: Option<(u64, Vec<Ray>)>,
+    /// For a moving vehicle and a caster that takes whole frames: every row's beams in the sensor
+    /// frame, cast from each frame's shot poses ([`Caster::cast_beams`]: rays made on the device).
+    beam_set: Option<crate::cast::BeamSet>,
     planes: usize,
     track: PoseTrack,
     frame_period_s: f64,
@@ -274,6 +279,7 @@ impl<'a> Scanner<'a> {
             config,
             static_beams: None,
             static_ray_set: None,
+            beam_set: None,
             shot_times,
         };
         if scanner.track.is_static() {
@@ -289,6 +295,8 @@ impl<'a> Scanner<'a> {
                 scanner.static_ray_set = Some((crate::cast::new_ray_set_key(), rays));
             }
             scanner.static_beams = Some(cached);
+        } else if scanner.caster.prefers_frames() {
+            scanner.beam_set = scanner.beam_set();
         }
         Ok(scanner)
     }
@@ -330,8 +338,13 @@ impl<'a> Scanner<'a> {
 
     /// Scans frame `index` into a new cloud.
     pub fn frame(&self, index: usize) -> Frame {
+        self.frame_with(index, None)
+    }
+
+    /// [`Scanner::frame`] with the hits cast ahead when `ahead` is given.
+    fn frame_with(&self, index: usize, ahead: Option<CastAhead>) -> Frame {
         let mut cloud = OrderedCloud::default();
-        self.frame_into(index, &mut cloud);
+        self.frame_into_with(index, &mut cloud, ahead);
         let vehicle_pose = self.track.frame_start(index);
         Frame {
             index,
@@ -352,6 +365,12 @@ impl<'a> Scanner<'a> {
     /// written exactly once per frame (a return or the no-return defaults), so a reused cloud needs
     /// no separate reset pass.
     pub fn frame_into(&self, index: usize, cloud: &mut OrderedCloud) {
+        self.frame_into_with(index, cloud, None);
+    }
+
+    /// [`Scanner::frame_into`], with the frame's shot poses and hits already cast when `ahead` is
+    /// given ([`Scanner::scan_frames`]).
+    fn frame_into_with(&self, index: usize, cloud: &mut OrderedCloud, ahead: Option<CastAhead>) {
         use rayon::prelude::*;
         let (rows, cols, planes) = (self.layout.rows, self.layout.cols, self.planes);
         let fresh = (cloud.rows, cloud.cols, cloud.planes) != (rows, cols, planes) || cloud.check_consistent().is_err();
@@ -361,7 +380,10 @@ impl<'a> Scanner<'a> {
             cloud.reset_cells(rows * cols..cloud.len());
         }
         let start_time_s = index as f64 * self.frame_period_s;
-        let shot_poses = self.shot_poses(index);
+        let (shot_poses, hits) = match ahead {
+            Some(a) => (a.shot_poses, Some(a.hits)),
+            None => (self.shot_poses(index), None),
+        };
         let extra: Vec<Vec<ExtraEcho>> = if cols == 0 {
             Vec::new()
         } else {
@@ -369,7 +391,7 @@ impl<'a> Scanner<'a> {
             // from one row to the next (each row overwrites what it reads), so the output does not
             // depend on how rows are split among threads.
             if self.caster.prefers_frames() {
-                let extra = self.scan_frame_at_once(index, start_time_s, cloud, &shot_poses);
+                let extra = self.scan_frame_at_once(index, start_time_s, cloud, &shot_poses, hits);
                 return self.finish_frame(cloud, extra);
             }
             row_views(cloud)

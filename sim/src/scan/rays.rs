@@ -4,7 +4,7 @@
 use glam::{Affine3A, Vec3};
 
 use super::Scanner;
-use crate::cast::Ray;
+use crate::cast::{Beam, BeamSet, Ray};
 use crate::effects::cast_limit_m;
 use crate::sensor::{Firing, ScanPattern};
 
@@ -35,6 +35,46 @@ impl Scanner<'_> {
             })
             .collect();
         RowRays { beams, rays: row_beams.rays, sub_rays: row_beams.sub_rays }
+    }
+
+    /// Every merged row's beams in the sensor frame, in the order [`Scanner::fill_row_beams`] makes
+    /// their rays (rows, fired columns, sub-rays), each placed by its sensor's pose at its shot
+    /// time: the poses of a frame are every sensor's [`Scanner::shot_poses`] one after another.
+    /// A caster that makes rays on a device casts moving frames from it ([`Caster::cast_beams`]).
+    /// Sub-ray directions are turned in the sensor frame, which a rigid pose preserves.
+    ///
+    /// [`Caster::cast_beams`]: crate::cast::Caster::cast_beams
+    pub(super) fn beam_set(&self) -> Option<BeamSet> {
+        let mut first_pose = Vec::with_capacity(self.shot_times.len());
+        let mut poses = 0;
+        for shots in &self.shot_times {
+            first_pose.push(poses);
+            poses += shots.times.len();
+        }
+        let mut beams = Vec::new();
+        for &(s, ring) in &self.row_source {
+            let pattern = &self.patterns[s];
+            let m = &self.measurements[s];
+            let t_max_m = cast_limit_m(m);
+            let sub_rays = m.max_echoes > 1 && m.beam_divergence_rad > 0.0;
+            let off = (0.5 * m.beam_divergence_rad).tan();
+            let firings = &pattern.firings[ring * pattern.cols..(ring + 1) * pattern.cols];
+            let shot_of = &self.shot_times[s].index[ring * pattern.cols..(ring + 1) * pattern.cols];
+            for (f, &shot) in firings.iter().zip(shot_of) {
+                let Some(f) = f else { continue };
+                let pose = u32::try_from(first_pose[s] + shot as usize).ok()?;
+                let dir = f.dir_in_sensor.normalize();
+                let beam = Beam { origin_in_sensor: f.origin_in_sensor, dir_in_sensor: dir, t_max_m, pose };
+                beams.push(beam);
+                if sub_rays {
+                    let side = f.dir_in_sensor.cross(Vec3::Z).normalize_or_zero();
+                    for sign in [-1.0f32, 1.0] {
+                        beams.push(Beam { dir_in_sensor: (dir + side * (sign * off)).normalize(), ..beam });
+                    }
+                }
+            }
+        }
+        BeamSet::new(beams, poses).ok()
     }
 
     /// A moving vehicle's pose in frame `frame` at each distinct shot time of each sensor (indexed
@@ -106,6 +146,12 @@ impl Scanner<'_> {
             }
         }
     }
+}
+
+/// A frame's poses in the order of [`Scanner::beam_set`]'s pose slots: every sensor's shot poses
+/// one after another.
+pub(super) fn frame_poses(shot_poses: &[Vec<ShotPose>]) -> Vec<Affine3A> {
+    shot_poses.iter().flatten().map(|p| p.world_from_sensor).collect()
 }
 
 /// The sensor pose at one shot.

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::Scanner;
 use super::cells::{Cell, ExtraEcho, RowView, row_views};
-use super::rays::{NO_BEAM, RowBeams, ShotPose};
+use super::rays::{NO_BEAM, RowBeams, ShotPose, frame_poses};
 use crate::cast::{Hit, Ray};
 use crate::cloud::OrderedCloud;
 use crate::effects::measure;
@@ -50,20 +50,36 @@ impl Scanner<'_> {
         start_time_s: f64,
         cloud: &mut OrderedCloud,
         shot_poses: &[Vec<ShotPose>],
+        cast_ahead: Option<Vec<Option<Hit>>>,
     ) -> Vec<Vec<ExtraEcho>> {
         use rayon::prelude::*;
+        let build = || -> Vec<RowBeams> {
+            (0..self.layout.rows)
+                .into_par_iter()
+                .map(|row| {
+                    let mut beams = RowBeams::default();
+                    self.fill_row_beams(frame, row, &mut beams, shot_poses);
+                    beams
+                })
+                .collect()
+        };
         let built: Vec<RowBeams>;
-        let (beams, hits) = match (&self.static_beams, &self.static_ray_set) {
-            (Some(cached), Some((key, rays))) => (cached.as_slice(), self.caster.cast_all_resident(*key, rays)),
+        let (beams, hits) = match (&self.static_beams, &self.static_ray_set, &self.beam_set, cast_ahead) {
+            (Some(cached), Some((key, rays)), _, _) => (cached.as_slice(), self.caster.cast_all_resident(*key, rays)),
+            // Hits cast ahead by the pipeline (`Scanner::scan_frames`): the rows' rays are still made
+            // here, for measuring.
+            (_, _, _, Some(hits)) => {
+                built = build();
+                (built.as_slice(), hits)
+            }
+            // Rays made on the device while the host makes the same rays for measuring.
+            (_, _, Some(set), None) => {
+                let (rows, hits) = rayon::join(build, || self.caster.cast_beams(set, &frame_poses(shot_poses)));
+                built = rows;
+                (built.as_slice(), hits)
+            }
             _ => {
-                built = (0..self.layout.rows)
-                    .into_par_iter()
-                    .map(|row| {
-                        let mut beams = RowBeams::default();
-                        self.fill_row_beams(frame, row, &mut beams, shot_poses);
-                        beams
-                    })
-                    .collect();
+                built = build();
                 let rays: Vec<Ray> = built.iter().flat_map(|b| b.rays.iter().copied()).collect();
                 (built.as_slice(), self.caster.cast_all(&rays))
             }

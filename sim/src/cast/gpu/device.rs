@@ -16,11 +16,10 @@ pub(super) enum Timestamps {
     Encoder,
 }
 
-/// A device, its queue and the compiled ray-casting shader.
+/// A device, its queue and the bind group layout of the casting kernels.
 pub(super) struct Gpu {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
-    pub(super) shader: wgpu::ShaderModule,
     pub(super) pipeline_layout: wgpu::PipelineLayout,
     pub(super) layout: wgpu::BindGroupLayout,
     /// The timestamps this device takes.
@@ -64,9 +63,9 @@ fn describe(info: &wgpu::AdapterInfo) -> String {
 }
 
 impl Gpu {
-    /// Opens the device (with timestamp queries where the adapter has them) and compiles
-    /// `cast.wgsl`; the pipeline is made per scene ([`super::scene::SceneBuffers`]), whose split
-    /// into bindings sets its constants.
+    /// Opens the device (with timestamp queries where the adapter has them); the shader and its
+    /// pipelines are made per scene ([`super::scene::SceneBuffers`]), whose BVH layout picks the
+    /// traversal and whose split into bindings sets its constants.
     pub(super) fn new() -> Result<Self, GpuError> {
         let adapter = adapter()?;
         let info = adapter.get_info();
@@ -94,10 +93,6 @@ impl Gpu {
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
             .map_err(|e| GpuError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("cast.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("cast.wgsl").into()),
-        });
         let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -141,7 +136,6 @@ impl Gpu {
         Ok(Self {
             device,
             queue,
-            shader,
             pipeline_layout,
             layout,
             timestamps,

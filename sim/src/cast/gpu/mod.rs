@@ -31,7 +31,7 @@ use std::sync::Mutex;
 
 use thiserror::Error;
 
-use super::{BvhCaster, Caster, DeviceStats, Hit, Ray};
+use super::{BeamSet, BvhCaster, Caster, DeviceStats, Hit, Ray};
 use crate::scene::SceneMesh;
 
 pub use device::adapter_description;
@@ -180,6 +180,30 @@ impl Caster for GpuCaster {
         let mut out = vec![None; rays.len()];
         self.cast_gpu(rays, Some(key), &mut out);
         out
+    }
+
+    /// The beams kept on the device, the rays made there (module docs); a set that does not fit a
+    /// binding with one frame's poses is cast from rays made on the host.
+    fn cast_beams(&self, beams: &BeamSet, poses: &[glam::Affine3A]) -> Vec<Option<Hit>> {
+        let mut raw = Vec::new();
+        let mut stream = self.lock();
+        if stream.cast_beams(&self.gpu, &self.scene, beams, poses, &mut raw).is_err() {
+            drop(stream);
+            return self.cast_all(&beams.rays(poses));
+        }
+        let (n, per) = (beams.beams().len(), beams.poses_per_frame());
+        raw.into_iter()
+            .enumerate()
+            .map(|(r, (t_bits, prim))| match prim {
+                stream::MISS => None,
+                stream::OVERFLOW => {
+                    stream.stats.cpu_fallbacks += 1;
+                    let (frame, b) = (r / n, r % n);
+                    self.cpu.cast(&beams.ray(b, &poses[frame * per + beams.beams()[b].pose as usize]))
+                }
+                p => Some(Hit { t: f32::from_bits(t_bits), triangle: self.scene.order_to_triangle[p as usize] }),
+            })
+            .collect()
     }
 
     fn prefers_frames(&self) -> bool {

@@ -25,7 +25,10 @@ pub(super) struct SceneBuffers {
     nodes: Vec<wgpu::Buffer>,
     /// Triangle bindings (unused ones hold a small placeholder).
     tris: Vec<wgpu::Buffer>,
+    /// The kernel for rays made on the host (`main` of `cast.wgsl`).
     pub(super) pipeline: wgpu::ComputePipeline,
+    /// The kernel for rays made on the device from a beam set and poses (`main_beams`).
+    pub(super) beam_pipeline: wgpu::ComputePipeline,
     /// Leaf order -> index into `SceneMesh::triangles`.
     pub(super) order_to_triangle: Vec<u32>,
     /// Whether the scene has no triangles (every ray misses).
@@ -109,18 +112,26 @@ impl SceneBuffers {
             ("NODE_SHIFT", f64::from(if node_bindings > 1 { node_shift } else { NO_SPLIT })),
             ("TRI_SHIFT", f64::from(if tri_bindings > 1 { tri_shift } else { NO_SPLIT })),
         ];
-        let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("cast"),
-            layout: Some(&gpu.pipeline_layout),
-            module: &gpu.shader,
-            entry_point: Some("main"),
-            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
-            cache: None,
+        let shader = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("bvh2.wgsl + cast.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(concat!(include_str!("bvh2.wgsl"), include_str!("cast.wgsl")).into()),
         });
+        let pipeline_for = |entry_point: &str| {
+            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&gpu.pipeline_layout),
+                module: &shader,
+                entry_point: Some(entry_point),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                cache: None,
+            })
+        };
+        let (pipeline, beam_pipeline) = (pipeline_for("main"), pipeline_for("main_beams"));
         Ok(Self {
             nodes,
             tris,
             pipeline,
+            beam_pipeline,
             empty: order_to_triangle.is_empty(),
             order_to_triangle,
             bindings_used: (node_bindings, tri_bindings),

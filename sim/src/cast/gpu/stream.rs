@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use super::device::{Gpu, Timestamps};
 use super::scene::SceneBuffers;
-use crate::cast::{DeviceStats, Ray};
+use crate::cast::{BeamSet, DeviceStats, Ray};
 
 /// Result triangle of a ray that hit nothing.
 pub(super) const MISS: u32 = u32::MAX;
@@ -22,8 +22,11 @@ const MAX_BATCH_RAYS: u64 = 1 << 20;
 /// Bytes per ray on the device (two `vec4<f32>`) and per result (`vec2<u32>`).
 const RAY_BYTES: u64 = 32;
 const HIT_BYTES: u64 = 8;
+/// Bytes per beam on the device (two `vec4<f32>`) and per pose (three).
+const BEAM_BYTES: u64 = 32;
+const POSE_BYTES: u64 = 48;
 /// Bytes of the uniform parameters and of the four timestamps.
-const PARAM_BYTES: u64 = 16;
+const PARAM_BYTES: u64 = 32;
 const STAMP_BYTES: u64 = 32;
 /// Batches in flight: one read back while the next runs.
 const SLOTS: usize = 2;
@@ -76,6 +79,38 @@ impl Slot {
         });
         Self { capacity, rays, hits, params, readback, bind, queries }
     }
+
+    /// A bind group like the slot's own with `input` (a beam set and its poses) at binding 6.
+    fn bind_with(&self, gpu: &Gpu, scene: &SceneBuffers, input: &wgpu::Buffer) -> wgpu::BindGroup {
+        let mut entries = scene.entries();
+        entries.push(wgpu::BindGroupEntry { binding: 6, resource: input.as_entire_binding() });
+        entries.push(wgpu::BindGroupEntry { binding: 7, resource: self.hits.as_entire_binding() });
+        entries.push(wgpu::BindGroupEntry { binding: 8, resource: self.params.as_entire_binding() });
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("caster (beams)"),
+            layout: &gpu.layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// A beam set kept on the device: the beams, then room for the poses of `frames` frames.
+struct BeamInput {
+    key: u64,
+    buffer: wgpu::Buffer,
+    /// Frames whose poses fit after the beams.
+    frames: usize,
+}
+
+/// What a call's batches read.
+enum Input<'a> {
+    /// Rays made on the host, uploaded batch by batch.
+    Rays(&'a [Ray]),
+    /// Rays kept on the device, a buffer per batch.
+    Resident(&'a [wgpu::Buffer]),
+    /// Rays made on the device: one bind group per slot, beams per frame, the first pose's vec4 and
+    /// poses per frame.
+    Beams { binds: Vec<wgpu::BindGroup>, beams: u32, pose_base: u32, poses: u32 },
 }
 
 /// A standing rig's rays kept on the device, one buffer per batch.
@@ -85,12 +120,13 @@ struct Resident {
     batches: Vec<wgpu::Buffer>,
 }
 
-/// The device side of a caster: batch slots, the upload belt, the resident rays and the counters.
-/// Callers take it under a lock: the device's queue runs one stream of batches anyway.
+/// The device side of a caster: batch slots, the upload belt, the resident rays and beams, and the
+/// counters. Callers take it under a lock: the device's queue runs one stream of batches anyway.
 pub(super) struct Stream {
     slots: Vec<Slot>,
     belt: wgpu::util::StagingBelt,
     resident: Option<Resident>,
+    beams: Option<BeamInput>,
     pub(super) stats: DeviceStats,
     packed: Vec<f32>,
 }
@@ -108,6 +144,7 @@ impl Stream {
             slots: Vec::new(),
             belt: wgpu::util::StagingBelt::new(gpu.device.clone(), 4 << 20),
             resident: None,
+            beams: None,
             stats: DeviceStats::default(),
             packed: Vec::new(),
         }
@@ -116,6 +153,13 @@ impl Stream {
     /// Rays per batch on this device: within the storage-binding limit and the dispatch limit.
     fn batch_rays(gpu: &Gpu) -> usize {
         (gpu.max_binding_bytes / RAY_BYTES).clamp(64, MAX_BATCH_RAYS) as usize
+    }
+
+    /// Batch slots for batches of `batch` rays (kept when large enough).
+    fn ensure_slots(&mut self, gpu: &Gpu, scene: &SceneBuffers, batch: usize) {
+        if self.slots.first().is_none_or(|s| s.capacity < batch) {
+            self.slots = (0..SLOTS).map(|_| Slot::new(gpu, scene, batch)).collect();
+        }
     }
 
     /// Appends `(t bits, leaf-order triangle or MISS / OVERFLOW)` of every ray to `out`. With a
@@ -135,9 +179,7 @@ impl Stream {
         }
         let t0 = Instant::now();
         let batch = Self::batch_rays(gpu).min(rays.len());
-        if self.slots.first().is_none_or(|s| s.capacity < batch) {
-            self.slots = (0..SLOTS).map(|_| Slot::new(gpu, scene, batch)).collect();
-        }
+        self.ensure_slots(gpu, scene, batch);
         let ranges: Vec<Range<usize>> =
             (0..rays.len()).step_by(batch).map(|a| a..(a + batch).min(rays.len())).collect();
         if let Some(key) = resident
@@ -145,8 +187,108 @@ impl Stream {
         {
             self.resident = Some(self.upload_resident(gpu, key, rays, &ranges));
         }
-        let Stream { slots, belt, resident: kept, stats, packed } = self;
-        let kept = resident.and(kept.as_ref()).map(|r| &r.batches);
+        let kept = resident.and(self.resident.take());
+        let input = match &kept {
+            Some(r) => Input::Resident(&r.batches),
+            None => Input::Rays(rays),
+        };
+        self.run(gpu, scene, &input, ranges, out);
+        if kept.is_some() {
+            self.resident = kept;
+        }
+        self.stats.wall_s += t0.elapsed().as_secs_f64();
+    }
+
+    /// Appends the hits of `beams` placed by every frame's poses (frame after frame, beam order)
+    /// to `out`, the rays made on the device: the beams go up once per set, the poses per call.
+    /// `Err` (nothing appended) when the beams and one frame's poses exceed a binding.
+    pub(super) fn cast_beams(
+        &mut self,
+        gpu: &Gpu,
+        scene: &SceneBuffers,
+        set: &BeamSet,
+        poses: &[glam::Affine3A],
+        out: &mut Vec<(u32, u32)>,
+    ) -> Result<(), super::GpuError> {
+        let (n, per) = (set.beams().len(), set.poses_per_frame());
+        let frames = set.frames_in(poses);
+        if scene.empty || n == 0 || frames == 0 {
+            out.extend(std::iter::repeat_n((0, MISS), n * frames));
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let beam_bytes = n as u64 * BEAM_BYTES;
+        let frame_bytes = per as u64 * POSE_BYTES;
+        let room = gpu.max_binding_bytes.saturating_sub(beam_bytes) / frame_bytes.max(1);
+        if room == 0 {
+            return Err(super::GpuError::TooLarge {
+                buffer: "beams and one frame's poses",
+                needed_bytes: beam_bytes + frame_bytes,
+                limit_bytes: gpu.max_binding_bytes,
+            });
+        }
+        // Frames per chunk: all of them, within a binding and 64 MiB of poses.
+        let chunk_frames = (frames as u64).min(room).min(((64 << 20) / frame_bytes).max(1)) as usize;
+        if self.beams.as_ref().is_none_or(|b| b.key != set.key() || b.frames < chunk_frames) {
+            self.beams = Some(self.upload_beams(gpu, set, chunk_frames));
+        }
+        let Some(kept) = self.beams.take() else { return Ok(()) };
+        let batch = Self::batch_rays(gpu).min(n * chunk_frames);
+        self.ensure_slots(gpu, scene, batch);
+        let binds: Vec<wgpu::BindGroup> = self.slots.iter().map(|s| s.bind_with(gpu, scene, &kept.buffer)).collect();
+        let input = Input::Beams { binds, beams: n as u32, pose_base: 2 * n as u32, poses: per as u32 };
+        let mut rows = Vec::new();
+        for chunk in poses[..frames * per].chunks(chunk_frames * per) {
+            rows.clear();
+            for m in chunk {
+                let (r, t) = (m.matrix3, m.translation);
+                rows.extend_from_slice(&[r.x_axis.x, r.y_axis.x, r.z_axis.x, t.x]);
+                rows.extend_from_slice(&[r.x_axis.y, r.y_axis.y, r.z_axis.y, t.y]);
+                rows.extend_from_slice(&[r.x_axis.z, r.y_axis.z, r.z_axis.z, t.z]);
+            }
+            // The previous chunk's batches were all read back: its poses are no longer in use.
+            gpu.queue.write_buffer(&kept.buffer, beam_bytes, bytemuck::cast_slice(&rows));
+            self.stats.upload_bytes += std::mem::size_of_val(rows.as_slice()) as u64;
+            let total = n * (chunk.len() / per);
+            let ranges = (0..total).step_by(batch).map(|a| a..(a + batch).min(total)).collect();
+            self.run(gpu, scene, &input, ranges, out);
+        }
+        self.beams = Some(kept);
+        self.stats.wall_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Uploads a beam set once, with room for the poses of `frames` frames after it.
+    fn upload_beams(&mut self, gpu: &Gpu, set: &BeamSet, frames: usize) -> BeamInput {
+        let mut packed = Vec::with_capacity(set.beams().len() * 8);
+        for b in set.beams() {
+            let (o, d) = (b.origin_in_sensor, b.dir_in_sensor);
+            packed.extend_from_slice(&[o.x, o.y, o.z, b.t_max_m.min(f32::MAX), d.x, d.y, d.z, f32::from_bits(b.pose)]);
+        }
+        let size = set.beams().len() as u64 * BEAM_BYTES + (frames * set.poses_per_frame()) as u64 * POSE_BYTES;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("beams and poses"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&packed));
+        self.stats.upload_bytes += std::mem::size_of_val(packed.as_slice()) as u64;
+        self.stats.resident_uploads += 1;
+        BeamInput { key: set.key(), buffer, frames }
+    }
+
+    /// Runs the batches `ranges` of `input`, one read back while the next runs, appending their
+    /// results to `out`.
+    fn run(
+        &mut self,
+        gpu: &Gpu,
+        scene: &SceneBuffers,
+        input: &Input<'_>,
+        ranges: Vec<Range<usize>>,
+        out: &mut Vec<(u32, u32)>,
+    ) {
+        let Stream { slots, belt, stats, packed, .. } = self;
         let mut in_flight: VecDeque<InFlight> = VecDeque::new();
         for (k, range) in ranges.into_iter().enumerate() {
             if in_flight.len() == SLOTS
@@ -164,17 +306,25 @@ impl Stream {
                 }
             };
             stamp(&mut encoder, 0);
-            match kept {
-                Some(batches) => encoder.copy_buffer_to_buffer(&batches[k], 0, &slot.rays, 0, m * RAY_BYTES),
-                None => {
+            let mut params = [m as u32, 0, 0, 0, 0, 0, 0, 0];
+            let (pipeline, bind) = match input {
+                Input::Resident(batches) => {
+                    encoder.copy_buffer_to_buffer(&batches[k], 0, &slot.rays, 0, m * RAY_BYTES);
+                    (&scene.pipeline, &slot.bind)
+                }
+                Input::Rays(rays) => {
                     pack(&rays[range.clone()], packed);
                     let size = NonZeroU64::new(m * RAY_BYTES).expect("a batch has rays");
                     belt.write_buffer(&mut encoder, &slot.rays, 0, size).copy_from_slice(bytemuck::cast_slice(packed));
                     stats.upload_bytes += m * RAY_BYTES;
+                    (&scene.pipeline, &slot.bind)
                 }
-            }
-            let params = [m as u32, 0, 0, 0];
-            belt.write_buffer(&mut encoder, &slot.params, 0, NonZeroU64::new(PARAM_BYTES).expect("16"))
+                Input::Beams { binds, beams, pose_base, poses } => {
+                    params[1..5].copy_from_slice(&[range.start as u32, *beams, *pose_base, *poses]);
+                    (&scene.beam_pipeline, &binds[k % SLOTS])
+                }
+            };
+            belt.write_buffer(&mut encoder, &slot.params, 0, NonZeroU64::new(PARAM_BYTES).expect("32"))
                 .copy_from_slice(bytemuck::cast_slice(&params));
             stamp(&mut encoder, 1);
             {
@@ -188,8 +338,8 @@ impl Stream {
                 };
                 let mut pass =
                     encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cast"), timestamp_writes });
-                pass.set_pipeline(&scene.pipeline);
-                pass.set_bind_group(0, &slot.bind, &[]);
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, bind, &[]);
                 pass.dispatch_workgroups((m as u32).div_ceil(64), 1, 1);
             }
             stamp(&mut encoder, 2);
@@ -220,7 +370,6 @@ impl Stream {
         while let Some(done) = in_flight.pop_front() {
             read_back(gpu, &slots[done.slot], done, stats, out);
         }
-        stats.wall_s += t0.elapsed().as_secs_f64();
     }
 
     /// Uploads `rays` once, a buffer per batch, for casting again without an upload.
