@@ -467,8 +467,8 @@ fn gpu_keeps_resident_rays_on_the_device() {
     assert_eq!(cpu.cast_all_resident(key, &rays[..1000]), cpu.cast_all(&rays[..1000]));
 }
 
-/// A spinning sensor's beams (32 rings x 1,024 columns, each column its own shot pose) cast from
-/// poses with the rays made on the device: the same hits as the host making the rays
+/// A spinning sensor's beams (32 rings x 1,024 columns, each column's pose blended from the key
+/// poses every 8 columns) cast from poses with the rays made on the device: the same hits as the host making the rays
 /// ([`BeamSet::rays`]) within the agreement of [`assert_agrees`]; the beams go up once, then only
 /// poses; a small binding limit splits the frames into chunks with the same hits.
 #[cfg(feature = "gpu")]
@@ -490,15 +490,18 @@ fn gpu_makes_rays_from_beams_and_poses() {
                 origin_in_sensor: Vec3::new(0.05, 0.0, 0.0),
                 dir_in_sensor: dir,
                 t_max_m: 120.0,
-                pose: col as u32,
+                pose: (col / 8) as u32,
+                pose_blend: (col % 8) as f32 / 8.0,
             });
         }
     }
-    let set = BeamSet::new(beams, cols).unwrap();
-    // Each frame drives 1.5 m and turns; each column's pose a little further along.
-    let poses: Vec<Affine3A> = (0..frames * cols)
+    // A pose every 8 columns (and one after the last), blended in between.
+    let keys = cols / 8 + 1;
+    let set = BeamSet::new(beams, keys).unwrap();
+    // Each frame drives 1.5 m and turns; each key pose a little further along.
+    let poses: Vec<Affine3A> = (0..frames * keys)
         .map(|i| {
-            let s = i as f32 / cols as f32;
+            let s = (i / keys) as f32 + (i % keys) as f32 / (keys - 1) as f32;
             Affine3A::from_translation(Vec3::new(0.3 + 1.5 * s, -0.2 + 0.1 * s, 4.0))
                 * Affine3A::from_rotation_z(0.05 * s)
         })
@@ -511,17 +514,17 @@ fn gpu_makes_rays_from_beams_and_poses() {
     let (hits, ties, disagree) = assert_agrees(&mesh, &rays, &expected, &got);
     let up1 = gpu.stats().upload_bytes - up0;
     eprintln!("{} rays from beams: {hits} hits, {ties} ties, {disagree} disagreements, {up1} B up", rays.len());
-    // The beams (32 B each) and the poses (48 B each), not 32 B per ray.
-    assert_eq!(up1, 32 * (rings * cols) as u64 + 48 * poses.len() as u64);
+    // The beams (48 B each) once and the poses (48 B each), not 32 B per ray.
+    assert_eq!(up1, 48 * (rings * cols) as u64 + 48 * poses.len() as u64);
     // Again: only the poses go up.
     assert_eq!(gpu.cast_beams(&set, &poses), got);
     assert_eq!(gpu.stats().upload_bytes - up0 - up1, 48 * poses.len() as u64);
     // Bindings that hold the beams and one or two frames' poses: the frames go in chunks.
-    let limit = 32 * (rings * cols) as u64 + 48 * cols as u64 * 3 / 2;
+    let limit = 48 * (rings * cols) as u64 + 48 * keys as u64 * 3 / 2;
     let small = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit) }).expect("an adapter");
     assert_eq!(small.cast_beams(&set, &poses), got);
     // Bindings too small for the beams: the rays are made on the host instead, same hits.
-    let tiny = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(16 * (rings * cols) as u64) });
+    let tiny = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(32 * (rings * cols) as u64) });
     let tiny = tiny.expect("an adapter");
     let on_host = tiny.cast_beams(&set, &poses);
     assert_agrees(&mesh, &rays, &expected, &on_host);

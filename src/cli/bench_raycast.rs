@@ -15,8 +15,8 @@ use std::time::Instant;
 
 use crate::cli::common::FIXTURE_TERRAIN;
 use anyhow::{Context, bail};
-use glam::Vec3;
-use sim::cast::{Backend, Ray, fixture};
+use glam::{Affine3A, Vec3};
+use sim::cast::{Backend, Beam, BeamSet, Ray, fixture};
 
 /// Rig name of the benchmark fixture LiDAR.
 const FIXTURE_RIG: &str = "fixture-128x2048";
@@ -91,20 +91,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (None, Some(p)) => (sim::scene::ply::read_mesh(p)?, 0.0, p.display().to_string()),
         (None, None) => bail!("give --scene NAME or --mesh FILE.ply"),
     };
-    // Ray files cast the same rays every frame (a standing sensor); rigs move 1 m per frame.
-    let same_every_frame = a.rays.is_some();
-    let rays = match (&a.rig, &a.rays) {
-        (Some(r), _) if r == FIXTURE_RIG => fixture::lidar_rays(a.frames),
-        (Some(r), _) => rig_rays(r, a.frames, ego_ground_z_m)
+    // Ray files cast the same rays every frame (a standing sensor); rigs move 1 m per frame and are
+    // cast from poses (rays made by the caster: on the device for the GPU).
+    let source = match (&a.rig, &a.rays) {
+        (Some(r), _) if r == FIXTURE_RIG => Source::Beams(fixture::lidar_beams(), fixture::lidar_poses(a.frames)),
+        (Some(r), _) => rig_beams(r, a.frames, ego_ground_z_m)
             .with_context(|| format!("rig `{r}` (the benchmark also knows `{FIXTURE_RIG}`)"))?,
         (None, Some(p)) => {
             let one = read_ray_file(p, a.max_range_m.unwrap_or(f32::INFINITY))?;
             if one.len().saturating_mul(a.frames) > MAX_RAYS {
                 bail!("{}: {} rays x {} frames is more than {MAX_RAYS} rays", p.display(), one.len(), a.frames);
             }
-            one.iter().cycle().take(one.len() * a.frames).copied().collect()
+            Source::Rays(one)
         }
         (None, None) => bail!("give --rig NAME or --rays FILE"),
+    };
+    let ray_count = match &source {
+        Source::Rays(one) => one.len() * a.frames,
+        Source::Beams(beams, poses) => beams.beams().len() * beams.frames_in(poses),
     };
     let backend = match a.backend {
         BackendArg::Bvh => Backend::Bvh,
@@ -119,17 +123,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let t1 = Instant::now();
     let cpu0 = process_cpu_s();
     // Frame by frame, as a scan casts: a standing sensor's rays under one key, so a device backend
-    // keeps them and uploads them once.
-    let per_frame = rays.len() / a.frames;
+    // keeps them and uploads them once; a moving rig's beams from each frame's pose, as many frames
+    // per call as a scan's pipeline casts together.
     let key = sim::cast::new_ray_set_key();
-    let hits: Vec<Option<sim::cast::Hit>> = pool.install(|| {
-        rays.chunks(per_frame.max(1))
-            .flat_map(
-                |frame| if same_every_frame { caster.cast_all_resident(key, frame) } else { caster.cast_all(frame) },
-            )
-            .collect()
+    let hits: Vec<Option<sim::cast::Hit>> = pool.install(|| match &source {
+        Source::Rays(one) => (0..a.frames).flat_map(|_| caster.cast_all_resident(key, one)).collect(),
+        Source::Beams(beams, poses) => {
+            poses.chunks(beams.frames_per_call()).flat_map(|p| caster.cast_beams(beams, p)).collect()
+        }
     });
     let cast_s = t1.elapsed().as_secs_f64();
+    crate::cli::common::check_device(caster.as_ref())?;
     let cast_cpu_s = process_cpu_s().zip(cpu0).map(|(b, a)| b - a);
     let hit_count = hits.iter().filter(|h| h.is_some()).count();
     let json = serde_json::json!({
@@ -139,16 +143,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "triangles": mesh.len(),
         "frames": a.frames,
         "threads": threads,
-        "rays": rays.len(),
+        "rays": ray_count,
         "hits": hit_count,
         "build_s": build_s,
         "cast_s": cast_s,
-        "rays_per_s": rays.len() as f64 / cast_s.max(1e-12),
+        "rays_per_s": ray_count as f64 / cast_s.max(1e-12),
         // CPU time of the whole process while casting (Linux; null elsewhere): on a shared,
         // loaded machine, rays per CPU-second per thread shows the speed the wall clock hides.
         "cast_cpu_s": cast_cpu_s,
-        "rays_per_cpu_s": cast_cpu_s.filter(|&c| c > 0.0).map(|c| rays.len() as f64 / c),
-        "device": caster.device_stats().map(|d| device_json(&d, rays.len())),
+        "rays_per_cpu_s": cast_cpu_s.filter(|&c| c > 0.0).map(|c| ray_count as f64 / c),
+        "device": caster.device_stats().map(|d| device_json(&d, ray_count)),
     });
     println!("{json}");
     Ok(())
@@ -190,29 +194,34 @@ fn process_cpu_s() -> Option<f64> {
     Some(ticks / 100.0)
 }
 
-/// The rays of `frames` frames of rig `name`: each sensor's beams placed by its mount, the vehicle on
-/// the ground at `(frame * 1 m, 0, ego_ground_z_m)`, range limited to the sensor's maximum range.
-fn rig_rays(name: &str, frames: usize, ego_ground_z_m: f32) -> anyhow::Result<Vec<Ray>> {
+/// What a benchmark casts: the same rays every frame, or beams placed by one pose per frame.
+enum Source {
+    Rays(Vec<Ray>),
+    Beams(BeamSet, Vec<Affine3A>),
+}
+
+/// The beams of rig `name` in the vehicle frame (each sensor's firings placed by its mount, range
+/// limited to the sensor's maximum range) and the vehicle's pose in each of `frames` frames: on the
+/// ground at `(frame * 1 m, 0, ego_ground_z_m)`.
+fn rig_beams(name: &str, frames: usize, ego_ground_z_m: f32) -> anyhow::Result<Source> {
     let rig = crate::cli::common::load_rig(name)?;
-    let mut one_frame = Vec::new();
+    let mut beams = Vec::new();
     for s in &rig.sensors {
         let vehicle_from_sensor = s.mount.vehicle_from_sensor();
-        let t_max = s.spec.measurement().max_range_m;
+        let t_max_m = s.spec.measurement().max_range_m;
         for f in s.spec.pattern().firings.iter().flatten() {
-            let origin = vehicle_from_sensor.transform_point3(f.origin_in_sensor);
-            let dir = vehicle_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
-            one_frame.push(Ray { origin, dir, t_max });
+            let origin_in_sensor = vehicle_from_sensor.transform_point3(f.origin_in_sensor);
+            let dir_in_sensor = vehicle_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
+            beams.push(Beam { origin_in_sensor, dir_in_sensor, t_max_m, pose: 0, pose_blend: 0.0 });
         }
     }
-    if one_frame.len().saturating_mul(frames) > MAX_RAYS {
-        bail!("rig `{name}`: {} rays x {frames} frames is more than {MAX_RAYS} rays", one_frame.len());
+    if beams.len().saturating_mul(frames) > MAX_RAYS {
+        bail!("rig `{name}`: {} rays x {frames} frames is more than {MAX_RAYS} rays", beams.len());
     }
-    let mut rays = Vec::with_capacity(one_frame.len() * frames);
-    for k in 0..frames {
-        let shift = Vec3::new(k as f32 * fixture::FRAME_STEP_M, 0.0, ego_ground_z_m);
-        rays.extend(one_frame.iter().map(|r| Ray { origin: r.origin + shift, ..*r }));
-    }
-    Ok(rays)
+    let poses = (0..frames)
+        .map(|k| Affine3A::from_translation(Vec3::new(k as f32 * fixture::FRAME_STEP_M, 0.0, ego_ground_z_m)))
+        .collect();
+    Ok(Source::Beams(BeamSet::new(beams, 1).with_context(|| format!("rig `{name}`"))?, poses))
 }
 
 /// Reads a raw ray file (see the module doc); directions are normalised, so `t` is metres.

@@ -118,3 +118,15 @@ pub fn method(
         }
     }
 }
+
+/// Fails with the caster's device fault (out of memory, an adapter lost mid-run), if any: results
+/// since then may be wrong, so the run stops before writing them (no fallback to the CPU: give
+/// `--backend bvh` for that).
+pub fn check_device(caster: &dyn sim::cast::Caster) -> anyhow::Result<()> {
+    match caster.fault() {
+        Some(fault) => {
+            anyhow::bail!("{fault} (the frames cast since are not written; `--backend bvh` casts on the CPU)")
+        }
+        None => Ok(()),
+    }
+}

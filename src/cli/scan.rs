@@ -186,14 +186,16 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
             }
             Ok(entries)
         });
-        for k in 0..args.frames {
-            // A failed writer has dropped the receiver: stop casting and report its error.
-            if sender.send(scanner.frame(k)).is_err() {
-                break;
-            }
-        }
+        // Frames in order; with a device caster the next frames are cast while this one is
+        // measured (`Scanner::scan_frames`). A failed writer has dropped the receiver: stop
+        // casting and report its error.
+        let cast = scanner.scan_frames(0..args.frames, |frame| -> anyhow::Result<()> {
+            crate::cli::common::check_device(scanner.caster())?;
+            sender.send(frame).map_err(|_| anyhow::anyhow!("the writer stopped"))
+        });
         drop(sender);
-        writer.join().map_err(|_| anyhow::anyhow!("the writer thread panicked"))?
+        let entries = writer.join().map_err(|_| anyhow::anyhow!("the writer thread panicked"))??;
+        cast.map(|()| entries)
     })?;
     if let Some(b) = bag {
         b.finish()?;

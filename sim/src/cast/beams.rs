@@ -18,6 +18,10 @@ pub struct Beam {
     pub t_max_m: f32,
     /// Which of a frame's poses places this beam (its sensor and shot time), `< poses_per_frame`.
     pub pose: u32,
+    /// How far toward pose `pose + 1` the beam's shot lies, in `[0, 1)`: the beam is placed by the
+    /// two poses blended linearly (rotation then normalised direction), so a sensor that fires at
+    /// thousands of times a frame needs only a few hundred poses per frame. 0: exactly `pose`.
+    pub pose_blend: f32,
 }
 
 /// Beams cast together, each placed by one of `poses_per_frame` poses per frame (module docs).
@@ -61,8 +65,12 @@ impl BeamSet {
     pub fn new(beams: Vec<Beam>, poses_per_frame: usize) -> Result<Self, BeamSetError> {
         for (i, b) in beams.iter().enumerate() {
             let bad = |field, value: String, allowed| BeamSetError::Value { beam: i, field, value, allowed };
-            if b.pose as usize >= poses_per_frame {
-                return Err(BeamSetError::Pose { beam: i, pose: b.pose, poses_per_frame });
+            if !(0.0..1.0).contains(&b.pose_blend) {
+                return Err(bad("pose_blend", b.pose_blend.to_string(), "0 <= blend < 1"));
+            }
+            let last = b.pose as usize + usize::from(b.pose_blend > 0.0);
+            if last >= poses_per_frame {
+                return Err(BeamSetError::Pose { beam: i, pose: last as u32, poses_per_frame });
             }
             if !b.origin_in_sensor.is_finite() {
                 return Err(bad("origin_in_sensor", format!("{}", b.origin_in_sensor), "finite"));
@@ -92,14 +100,32 @@ impl BeamSet {
         self.poses_per_frame
     }
 
+    /// Frames per [`Caster::cast_beams`](super::Caster::cast_beams) call a pipeline aims at: about
+    /// 2 M rays (several frames of a small rig per device dispatch), 1 to 16 frames.
+    pub fn frames_per_call(&self) -> usize {
+        const RAYS_PER_CALL: usize = 1 << 21;
+        (RAYS_PER_CALL / self.beams.len().max(1)).clamp(1, 16)
+    }
+
     /// Whole frames in `poses` (`poses_per_frame` each; a trailing partial frame is ignored).
     pub fn frames_in(&self, poses: &[Affine3A]) -> usize {
         poses.len() / self.poses_per_frame.max(1)
     }
 
-    /// The world ray of beam `b` placed by `world_from_sensor`.
-    pub fn ray(&self, b: usize, world_from_sensor: &Affine3A) -> Ray {
+    /// The world ray of beam `b` in a frame whose poses are `frame_poses`
+    /// ([`BeamSet::poses_per_frame`] of them).
+    pub fn ray(&self, b: usize, frame_poses: &[Affine3A]) -> Ray {
         let beam = &self.beams[b];
+        let pose = frame_poses[beam.pose as usize];
+        let world_from_sensor = if beam.pose_blend > 0.0 {
+            let (next, f) = (frame_poses[beam.pose as usize + 1], beam.pose_blend);
+            Affine3A {
+                matrix3: pose.matrix3 * (1.0 - f) + next.matrix3 * f,
+                translation: pose.translation.lerp(next.translation, f),
+            }
+        } else {
+            pose
+        };
         Ray {
             origin: world_from_sensor.transform_point3(beam.origin_in_sensor),
             dir: world_from_sensor.transform_vector3(beam.dir_in_sensor).normalize(),
@@ -117,7 +143,7 @@ impl BeamSet {
             for (j, ray) in chunk.iter_mut().enumerate() {
                 let r = k * super::CHUNK + j;
                 let (frame, b) = (r / n, r % n);
-                *ray = self.ray(b, &poses[frame * self.poses_per_frame + self.beams[b].pose as usize]);
+                *ray = self.ray(b, &poses[frame * self.poses_per_frame..(frame + 1) * self.poses_per_frame]);
             }
         });
         out
@@ -135,6 +161,7 @@ mod tests {
             dir_in_sensor: dir,
             t_max_m: 50.0,
             pose,
+            pose_blend: 0.0,
         };
         let set = BeamSet::new(vec![beam(Vec3::X, 0), beam(Vec3::Y, 1)], 2).unwrap();
         let poses = [
@@ -152,13 +179,23 @@ mod tests {
         assert_eq!(rays[3].origin, Vec3::new(5.1, 0.0, 0.0));
         // A partial frame is ignored.
         assert_eq!(set.rays(&poses[..3]).len(), 2);
+        // A quarter of the way from a pose to the next, 4 m and 10 mrad on: 1 m and 2.5 mrad on,
+        // to a few nanoradians (a linear blend's error grows with the square of the step).
+        let turned = Affine3A::from_translation(Vec3::new(4.0, 0.0, 0.0)) * Affine3A::from_rotation_z(0.01);
+        let blended = BeamSet::new(vec![Beam { pose_blend: 0.25, ..beam(Vec3::X, 0) }], 2).unwrap();
+        let r = blended.rays(&[Affine3A::IDENTITY, turned])[0];
+        assert!((r.dir - Vec3::new(0.0025f32.cos(), 0.0025f32.sin(), 0.0)).length() < 1e-6, "{}", r.dir);
+        assert!((r.origin - Vec3::new(1.0 + 0.1 * 0.0025f32.cos(), 0.1 * 0.0025f32.sin(), 0.0)).length() < 1e-6);
     }
 
     #[test]
     fn bad_beams_are_refused_naming_the_field() {
-        let ok = Beam { origin_in_sensor: Vec3::ZERO, dir_in_sensor: Vec3::Z, t_max_m: 1.0, pose: 0 };
+        let ok = Beam { origin_in_sensor: Vec3::ZERO, dir_in_sensor: Vec3::Z, t_max_m: 1.0, pose: 0, pose_blend: 0.0 };
         let err = |b: Beam| BeamSet::new(vec![ok, b], 1).unwrap_err().to_string();
         assert_eq!(err(Beam { pose: 1, ..ok }), "beam 1: pose 1 (allowed: 0 ..< 1)");
+        // A blend needs the next pose.
+        assert_eq!(err(Beam { pose_blend: 0.5, ..ok }), "beam 1: pose 1 (allowed: 0 ..< 1)");
+        assert!(err(Beam { pose_blend: 1.0, ..ok }).contains("pose_blend = 1 (allowed: 0 <= blend < 1)"));
         assert!(err(Beam { dir_in_sensor: Vec3::new(0.0, 0.0, 2.0), ..ok }).contains("dir_in_sensor"));
         assert!(err(Beam { origin_in_sensor: Vec3::NAN, ..ok }).contains("origin_in_sensor"));
         assert!(err(Beam { t_max_m: f32::NAN, ..ok }).contains("t_max_m = NaN (allowed: > 0 (infinity: unlimited))"));

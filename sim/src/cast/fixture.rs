@@ -90,6 +90,27 @@ pub fn lidar_rays(frames: usize) -> Vec<Ray> {
     rays
 }
 
+/// The fixture LiDAR as a beam set (one pose per frame, range unlimited), for casting from poses
+/// ([`super::Caster::cast_beams`]): the rays of [`lidar_rays`] up to rounding.
+pub fn lidar_beams() -> super::BeamSet {
+    let beams = (0..LIDAR_ROWS)
+        .flat_map(|r| (0..LIDAR_COLS).map(move |c| (r, c)))
+        .map(|(r, c)| super::Beam {
+            origin_in_sensor: Vec3::ZERO,
+            dir_in_sensor: beam_dir(r, c),
+            t_max_m: f32::INFINITY,
+            pose: 0,
+            pose_blend: 0.0,
+        })
+        .collect();
+    super::BeamSet::new(beams, 1).expect("unit directions, one pose")
+}
+
+/// The fixture LiDAR's pose in each of `frames` frames (a translation to [`sensor_origin`]).
+pub fn lidar_poses(frames: usize) -> Vec<glam::Affine3A> {
+    (0..frames).map(|f| glam::Affine3A::from_translation(sensor_origin(f))).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,5 +123,9 @@ mod tests {
         assert!(beam_dir(64, 0).x < -0.99);
         assert!(beam_dir(64, 512).y > 0.99);
         assert_eq!(lidar_rays(1).len(), 128 * 2048);
+        let (beams, poses) = (lidar_beams(), lidar_poses(2));
+        let (a, b) = (lidar_rays(2), beams.rays(&poses));
+        assert_eq!(a.len(), b.len());
+        assert!(a.iter().zip(&b).all(|(a, b)| a.origin == b.origin && (a.dir - b.dir).length() < 1e-6));
     }
 }

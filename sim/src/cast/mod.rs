@@ -127,6 +127,12 @@ pub trait Caster: Send + Sync {
         false
     }
 
+    /// What went wrong on a device backend's device (out of memory, a lost device), if anything:
+    /// results since may be wrong, and callers stop with this message. `None` for host backends.
+    fn fault(&self) -> Option<String> {
+        None
+    }
+
     /// Device counters and times for backends that run on a device, else `None`.
     fn device_stats(&self) -> Option<DeviceStats> {
         None

@@ -161,7 +161,7 @@ pub struct Scanner<'a> {
     static_ray_set: Option<(u64, Vec<Ray>)>,
     /// For a moving vehicle and a caster that takes whole frames: every row's beams in the sensor
     /// frame, cast from each frame's shot poses ([`Caster::cast_beams`]: rays made on the device).
-    beam_set: Option<crate::cast::BeamSet>,
+    beam_set: Option<rays::DeviceBeams>,
     planes: usize,
     track: PoseTrack,
     frame_period_s: f64,
@@ -296,7 +296,7 @@ impl<'a> Scanner<'a> {
             }
             scanner.static_beams = Some(cached);
         } else if scanner.caster.prefers_frames() {
-            scanner.beam_set = scanner.beam_set();
+            scanner.beam_set = scanner.device_beams();
         }
         Ok(scanner)
     }

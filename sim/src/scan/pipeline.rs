@@ -10,7 +10,7 @@ use std::ops::Range;
 
 use glam::Affine3A;
 
-use super::rays::{ShotPose, frame_poses};
+use super::rays::ShotPose;
 use super::{Frame, Scanner};
 use crate::cast::Hit;
 
@@ -20,25 +20,20 @@ pub(super) struct CastAhead {
     pub(super) hits: Vec<Option<Hit>>,
 }
 
-/// Rays per device call the casting thread aims at: a small rig's frames go several to a call.
-const RAYS_PER_CALL: usize = 1 << 21;
-/// Frames per device call at most.
-const MAX_FRAMES_PER_CALL: usize = 16;
-
 impl Scanner<'_> {
     /// Scans `frames` in order and hands each to `each`; stops at the first error `each` returns and
     /// returns it. With a caster that makes rays on a device and a moving vehicle, the next frames
     /// are cast while this one is measured and handed over (module docs); otherwise frame after
     /// frame through [`Scanner::frame`]. Same frames either way.
     pub fn scan_frames<E>(&self, frames: Range<usize>, mut each: impl FnMut(Frame) -> Result<(), E>) -> Result<(), E> {
-        let Some(set) = &self.beam_set else {
+        let Some(beams) = &self.beam_set else {
             for k in frames {
                 each(self.frame(k))?;
             }
             return Ok(());
         };
-        let n = set.beams().len();
-        let per_call = (RAYS_PER_CALL / n.max(1)).clamp(1, MAX_FRAMES_PER_CALL);
+        let n = beams.set.beams().len();
+        let per_call = beams.set.frames_per_call();
         let frames: Vec<usize> = frames.collect();
         std::thread::scope(|scope| {
             // One call's frames in flight while the previous call's are measured.
@@ -47,8 +42,8 @@ impl Scanner<'_> {
             scope.spawn(move || {
                 for call in frames.chunks(per_call) {
                     let shot_poses: Vec<Vec<Vec<ShotPose>>> = call.iter().map(|&k| self.shot_poses(k)).collect();
-                    let poses: Vec<Affine3A> = shot_poses.iter().flat_map(|s| frame_poses(s)).collect();
-                    let mut hits = self.caster.cast_beams(set, &poses);
+                    let poses: Vec<Affine3A> = call.iter().flat_map(|&k| self.device_poses(beams, k)).collect();
+                    let mut hits = self.caster.cast_beams(&beams.set, &poses);
                     let mut cast = Vec::with_capacity(call.len());
                     for (i, (&k, shot_poses)) in call.iter().zip(shot_poses).enumerate().rev() {
                         cast.push((k, CastAhead { shot_poses, hits: hits.split_off(i * n) }));
@@ -133,7 +128,7 @@ mod tests {
                 surfaces: Arc::new(surfaces),
             };
             let beams = Scanner::with_prepared(&mesh, &rig, config.clone(), &prepared).unwrap();
-            let set = beams.beam_set.as_ref().expect("a moving rig on a frame caster casts beams");
+            let set = &beams.beam_set.as_ref().expect("a moving rig on a frame caster casts beams").set;
             let fired: usize = beams.patterns.iter().map(|p| p.firings.iter().flatten().count()).sum();
             assert!(set.beams().len() >= fired, "{} beams for {fired} firings", set.beams().len());
             let reference = Scanner::new(&mesh, &rig, config).unwrap();

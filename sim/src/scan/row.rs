@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::Scanner;
 use super::cells::{Cell, ExtraEcho, RowView, row_views};
-use super::rays::{NO_BEAM, RowBeams, ShotPose, frame_poses};
+use super::rays::{NO_BEAM, RowBeams, ShotPose};
 use crate::cast::{Hit, Ray};
 use crate::cloud::OrderedCloud;
 use crate::effects::measure;
@@ -73,8 +73,9 @@ impl Scanner<'_> {
                 (built.as_slice(), hits)
             }
             // Rays made on the device while the host makes the same rays for measuring.
-            (_, _, Some(set), None) => {
-                let (rows, hits) = rayon::join(build, || self.caster.cast_beams(set, &frame_poses(shot_poses)));
+            (_, _, Some(beams), None) => {
+                let poses = self.device_poses(beams, frame);
+                let (rows, hits) = rayon::join(build, || self.caster.cast_beams(&beams.set, &poses));
                 built = rows;
                 (built.as_slice(), hits)
             }

@@ -333,6 +333,7 @@ fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bo
     };
     let scan_frame = |k: usize| -> anyhow::Result<sim::scan::Frame> {
         let mut frame = scanner.frame(k);
+        crate::cli::common::check_device(scanner.caster())?;
         vary(&mut frame.cloud, s, k)?;
         Ok(frame)
     };

@@ -107,6 +107,7 @@ pub fn evaluate(
     let mut stats = PointStats::new();
     for k in 0..sweep.frames {
         scanner.frame_into(k, cloud);
+        crate::cli::common::check_device(scanner.caster())?;
         stats.add(cloud, body_xy);
         let input =
             FrameInput { index: k, cloud, world_from_vehicle: Some(scanner.frame_start_pose(k).world_from_vehicle()) };

@@ -3,12 +3,13 @@
 //
 // main:       rays made on the host. input: 2 vec4 per ray: (origin.xyz, t_max), (dir.xyz, 0).
 // main_beams: rays made here from a beam set kept on the device and poses per frame. input: the
-//             beams, 2 vec4 each: (origin_in_sensor.xyz, t_max), (dir_in_sensor.xyz, pose slot
-//             bits); then from vec4 `pose_base` on, 3 vec4 per pose: the rows of the 3 x 4
-//             `world_from_sensor` (rotation | translation), `poses` per frame, frame after frame.
-//             Ray r of the call is beam (r % beams) of frame (r / beams) of the call; its origin is
-//             the pose applied to the beam's origin, its direction the rotated beam direction,
-//             normalised.
+//             beams, 3 vec4 each: (origin_in_sensor.xyz, t_max), (dir_in_sensor.xyz, pose bits),
+//             (pose_blend, 0, 0, 0); then from vec4 `pose_base` on, 3 vec4 per pose: the rows of
+//             the 3 x 4 `world_from_sensor` (rotation | translation), `poses` per frame, frame
+//             after frame. Ray r of the call is beam (r % beams) of frame (r / beams) of the call,
+//             placed by pose `pose` blended linearly toward pose `pose + 1` by `pose_blend`: its
+//             origin is the blend applied to the beam's origin, its direction the blend applied
+//             to the beam's direction, normalised (as `BeamSet::ray` on the host).
 // hits:       per ray of the batch (t bits, leaf-order triangle or MISS / OVERFLOW).
 
 struct Params {
@@ -51,12 +52,18 @@ fn main_beams(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = params.first + i;
     let frame = r / params.beams;
     let beam = r - frame * params.beams;
-    let a = input[2u * beam];
-    let b = input[2u * beam + 1u];
+    let a = input[3u * beam];
+    let b = input[3u * beam + 1u];
+    let blend = input[3u * beam + 2u].x;
     let p = params.pose_base + 3u * (frame * params.poses + bitcast<u32>(b.w));
-    let m0 = input[p];
-    let m1 = input[p + 1u];
-    let m2 = input[p + 2u];
+    var m0 = input[p];
+    var m1 = input[p + 1u];
+    var m2 = input[p + 2u];
+    if (blend > 0.0) {
+        m0 = mix(m0, input[p + 3u], blend);
+        m1 = mix(m1, input[p + 4u], blend);
+        m2 = mix(m2, input[p + 5u], blend);
+    }
     let o = vec3<f32>(dot(m0.xyz, a.xyz) + m0.w, dot(m1.xyz, a.xyz) + m1.w, dot(m2.xyz, a.xyz) + m2.w);
     let d = normalize(vec3<f32>(dot(m0.xyz, b.xyz), dot(m1.xyz, b.xyz), dot(m2.xyz, b.xyz)));
     hits[i] = trace(o, d, a.w);

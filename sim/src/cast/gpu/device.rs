@@ -30,6 +30,22 @@ pub(super) struct Gpu {
     pub(super) max_binding_bytes: u64,
     /// Adapter name, backend and type.
     pub(super) description: String,
+    /// The first error the device reported outside a call's results (out of memory, a validation
+    /// error, the device lost), if any: every result since may be wrong.
+    pub(super) fault: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+}
+
+impl Gpu {
+    /// Records `message` as the device's fault unless one is recorded already.
+    pub(super) fn record_fault(fault: &std::sync::Mutex<Option<String>>, message: String) {
+        let mut f = fault.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        f.get_or_insert(message);
+    }
+
+    /// The device's fault, if any (see [`Gpu::fault`]).
+    pub(super) fn fault(&self) -> Option<String> {
+        self.fault.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone()
+    }
 }
 
 /// The adapter wgpu's environment variables choose: `WGPU_ADAPTER_NAME` (a case-insensitive
@@ -131,6 +147,21 @@ impl Gpu {
             bind_group_layouts: &[Some(&layout)],
             ..Default::default()
         });
+        // Errors are recorded, not panics (wgpu's default): the caster reports them to its caller.
+        let fault = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let name = info.name.clone();
+        let on_error = std::sync::Arc::clone(&fault);
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            let kind = match &e {
+                wgpu::Error::OutOfMemory { .. } => "ran out of memory",
+                _ => "reported an error",
+            };
+            Self::record_fault(&on_error, format!("the GPU `{name}` {kind}: {e}"));
+        }));
+        let (name, on_lost) = (info.name.clone(), std::sync::Arc::clone(&fault));
+        device.set_device_lost_callback(move |reason, message| {
+            Self::record_fault(&on_lost, format!("the GPU `{name}` was lost ({reason:?}): {message}"));
+        });
         let max_binding_bytes = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         let timestamp_period_ns = f64::from(queue.get_timestamp_period());
         Ok(Self {
@@ -142,6 +173,7 @@ impl Gpu {
             timestamp_period_ns,
             max_binding_bytes,
             description,
+            fault,
         })
     }
 }

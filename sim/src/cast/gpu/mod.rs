@@ -129,6 +129,13 @@ impl GpuCaster {
         self.stats().cpu_fallbacks
     }
 
+    /// Destroys the device, as an adapter that disappears mid-run would (tests of the error path):
+    /// later calls record [`Caster::fault`] and return misses.
+    #[doc(hidden)]
+    pub fn destroy_device(&self) {
+        self.gpu.device.destroy();
+    }
+
     /// Counters and times of everything cast so far.
     pub fn stats(&self) -> DeviceStats {
         self.lock().stats
@@ -199,7 +206,7 @@ impl Caster for GpuCaster {
                 stream::OVERFLOW => {
                     stream.stats.cpu_fallbacks += 1;
                     let (frame, b) = (r / n, r % n);
-                    self.cpu.cast(&beams.ray(b, &poses[frame * per + beams.beams()[b].pose as usize]))
+                    self.cpu.cast(&beams.ray(b, &poses[frame * per..(frame + 1) * per]))
                 }
                 p => Some(Hit { t: f32::from_bits(t_bits), triangle: self.scene.order_to_triangle[p as usize] }),
             })
@@ -212,5 +219,9 @@ impl Caster for GpuCaster {
 
     fn device_stats(&self) -> Option<DeviceStats> {
         Some(self.stats())
+    }
+
+    fn fault(&self) -> Option<String> {
+        self.gpu.fault()
     }
 }

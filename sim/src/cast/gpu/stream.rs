@@ -13,8 +13,8 @@ use crate::cast::{BeamSet, DeviceStats, Ray};
 
 /// Result triangle of a ray that hit nothing.
 pub(super) const MISS: u32 = u32::MAX;
-/// Result triangle of a ray whose traversal overflowed the shader's stack, or whose readback
-/// failed (the host casts it on the CPU).
+/// Result triangle of a ray whose traversal overflowed the shader's stack (the host casts it on
+/// the CPU).
 pub(super) const OVERFLOW: u32 = u32::MAX - 1;
 
 /// Rays per dispatch at most (a workgroup of 64 per 64 rays, under the 65,535-workgroup limit).
@@ -22,8 +22,8 @@ const MAX_BATCH_RAYS: u64 = 1 << 20;
 /// Bytes per ray on the device (two `vec4<f32>`) and per result (`vec2<u32>`).
 const RAY_BYTES: u64 = 32;
 const HIT_BYTES: u64 = 8;
-/// Bytes per beam on the device (two `vec4<f32>`) and per pose (three).
-const BEAM_BYTES: u64 = 32;
+/// Bytes per beam on the device and per pose (three `vec4<f32>` each).
+const BEAM_BYTES: u64 = 48;
 const POSE_BYTES: u64 = 48;
 /// Bytes of the uniform parameters and of the four timestamps.
 const PARAM_BYTES: u64 = 32;
@@ -236,7 +236,7 @@ impl Stream {
         let batch = Self::batch_rays(gpu).min(n * chunk_frames);
         self.ensure_slots(gpu, scene, batch);
         let binds: Vec<wgpu::BindGroup> = self.slots.iter().map(|s| s.bind_with(gpu, scene, &kept.buffer)).collect();
-        let input = Input::Beams { binds, beams: n as u32, pose_base: 2 * n as u32, poses: per as u32 };
+        let input = Input::Beams { binds, beams: n as u32, pose_base: 3 * n as u32, poses: per as u32 };
         let mut rows = Vec::new();
         for chunk in poses[..frames * per].chunks(chunk_frames * per) {
             rows.clear();
@@ -260,10 +260,11 @@ impl Stream {
 
     /// Uploads a beam set once, with room for the poses of `frames` frames after it.
     fn upload_beams(&mut self, gpu: &Gpu, set: &BeamSet, frames: usize) -> BeamInput {
-        let mut packed = Vec::with_capacity(set.beams().len() * 8);
+        let mut packed = Vec::with_capacity(set.beams().len() * 12);
         for b in set.beams() {
             let (o, d) = (b.origin_in_sensor, b.dir_in_sensor);
             packed.extend_from_slice(&[o.x, o.y, o.z, b.t_max_m.min(f32::MAX), d.x, d.y, d.z, f32::from_bits(b.pose)]);
+            packed.extend_from_slice(&[b.pose_blend, 0.0, 0.0, 0.0]);
         }
         let size = set.beams().len() as u64 * BEAM_BYTES + (frames * set.poses_per_frame()) as u64 * POSE_BYTES;
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -417,8 +418,15 @@ fn read_back(gpu: &Gpu, slot: &Slot, done: InFlight, stats: &mut DeviceStats, ou
                 }
             }
         }
-        // The readback failed (a lost device): these rays go to the CPU caster.
-        Err(_) => out.extend(std::iter::repeat_n((0, OVERFLOW), m)),
+        // The readback failed (a lost device): recorded as the device's fault, which the caller
+        // reports; these rays count as misses meanwhile (no silent fallback to the CPU).
+        Err(e) => {
+            Gpu::record_fault(
+                &gpu.fault,
+                format!("reading results back from the GPU `{}` failed: {e}", gpu.description),
+            );
+            out.extend(std::iter::repeat_n((0, MISS), m));
+        }
     }
     slot.readback.unmap();
 }
