@@ -492,6 +492,7 @@ fn gpu_makes_rays_from_beams_and_poses() {
                 t_max_m: 120.0,
                 pose: (col / 8) as u32,
                 pose_blend: (col % 8) as f32 / 8.0,
+                side_offset: 0.0,
             });
         }
     }

@@ -35,9 +35,9 @@ fn pipelined_moving_frames_keep_the_contract() {
         let quantum = cpu.measurements().iter().map(|m| m.range_quantum_m).fold(0.0, f32::max);
         let mut indices = Vec::new();
         gpu.scan_frames(0..5, |frame| {
-            let agreement = Agreement::of(&cpu.frame(frame.index).cloud, &frame.cloud).unwrap();
+            let agreement = Agreement::of(&cpu.frame(frame.index).cloud, &frame.cloud, quantum).unwrap();
             assert!(agreement.both_hit > 500, "{name}: {agreement:?}");
-            let checked = AgreementContract::GPU.check(&agreement, quantum);
+            let checked = AgreementContract::GPU.check(&agreement);
             assert!(checked.is_ok(), "{name} frame {}: {checked:?}", frame.index);
             indices.push(frame.index);
             Ok::<(), ()>(())

@@ -60,17 +60,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let (tested, tested_s) = scan(&args.backend)?;
     let (reference, reference_s) = scan(&args.reference)?;
-    let mut total = Agreement::default();
-    for (a, b) in tested.iter().zip(&reference) {
-        total.add(&Agreement::of(a, b)?);
-    }
     // The coarsest range quantum of the rig's sensors (0 with --ideal).
     let quantum = if args.ideal {
         0.0
     } else {
         rig.sensors.iter().map(|s| s.spec.measurement().range_quantum_m).fold(0.0f32, f32::max)
     };
-    let verdict = AgreementContract::GPU.check(&total, quantum);
+    let mut total = Agreement::default();
+    for (a, b) in tested.iter().zip(&reference) {
+        total.add(&Agreement::of(a, b, quantum)?);
+    }
+    let verdict = AgreementContract::GPU.check(&total);
     let json = serde_json::json!({
         "scene": args.scene,
         "rig": args.rig,
@@ -84,6 +84,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "agreement": total,
         "hit_miss_share": total.hit_miss_share(),
         "label_share": total.label_share(),
+        "range_share": total.range_share(),
         "bit_equal_share": total.bit_equal_share(),
         "range_quantum_m": quantum,
         "contract": { "holds": verdict.is_ok(), "broken": verdict.as_ref().err() },

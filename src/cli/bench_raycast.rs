@@ -212,7 +212,7 @@ fn rig_beams(name: &str, frames: usize, ego_ground_z_m: f32) -> anyhow::Result<S
         for f in s.spec.pattern().firings.iter().flatten() {
             let origin_in_sensor = vehicle_from_sensor.transform_point3(f.origin_in_sensor);
             let dir_in_sensor = vehicle_from_sensor.transform_vector3(f.dir_in_sensor).normalize();
-            beams.push(Beam { origin_in_sensor, dir_in_sensor, t_max_m, pose: 0, pose_blend: 0.0 });
+            beams.push(Beam { origin_in_sensor, dir_in_sensor, t_max_m, pose: 0, pose_blend: 0.0, side_offset: 0.0 });
         }
     }
     if beams.len().saturating_mul(frames) > MAX_RAYS {

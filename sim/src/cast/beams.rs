@@ -22,6 +22,10 @@ pub struct Beam {
     /// two poses blended linearly (rotation then normalised direction), so a sensor that fires at
     /// thousands of times a frame needs only a few hundred poses per frame. 0: exactly `pose`.
     pub pose_blend: f32,
+    /// A sideways turn, for the sub-rays that sample a beam's divergence: the world direction
+    /// `d + side * side_offset`, normalised, where `d` is the beam's normalised world direction
+    /// and `side` that of `dir_in_sensor x z` (horizontal, to the beam's right). 0: the beam itself.
+    pub side_offset: f32,
 }
 
 /// Beams cast together, each placed by one of `poses_per_frame` poses per frame (module docs).
@@ -65,6 +69,9 @@ impl BeamSet {
     pub fn new(beams: Vec<Beam>, poses_per_frame: usize) -> Result<Self, BeamSetError> {
         for (i, b) in beams.iter().enumerate() {
             let bad = |field, value: String, allowed| BeamSetError::Value { beam: i, field, value, allowed };
+            if !b.side_offset.is_finite() {
+                return Err(bad("side_offset", b.side_offset.to_string(), "finite"));
+            }
             if !(0.0..1.0).contains(&b.pose_blend) {
                 return Err(bad("pose_blend", b.pose_blend.to_string(), "0 <= blend < 1"));
             }
@@ -126,11 +133,12 @@ impl BeamSet {
         } else {
             pose
         };
-        Ray {
-            origin: world_from_sensor.transform_point3(beam.origin_in_sensor),
-            dir: world_from_sensor.transform_vector3(beam.dir_in_sensor).normalize(),
-            t_max: beam.t_max_m,
+        let mut dir = world_from_sensor.transform_vector3(beam.dir_in_sensor).normalize();
+        if beam.side_offset != 0.0 {
+            let side = world_from_sensor.transform_vector3(beam.dir_in_sensor.cross(Vec3::Z)).normalize_or_zero();
+            dir = (dir + side * beam.side_offset).normalize();
         }
+        Ray { origin: world_from_sensor.transform_point3(beam.origin_in_sensor), dir, t_max: beam.t_max_m }
     }
 
     /// The world rays of every frame in `poses`, frame after frame, each in beam order (made on
@@ -162,6 +170,7 @@ mod tests {
             t_max_m: 50.0,
             pose,
             pose_blend: 0.0,
+            side_offset: 0.0,
         };
         let set = BeamSet::new(vec![beam(Vec3::X, 0), beam(Vec3::Y, 1)], 2).unwrap();
         let poses = [
@@ -190,11 +199,19 @@ mod tests {
 
     #[test]
     fn bad_beams_are_refused_naming_the_field() {
-        let ok = Beam { origin_in_sensor: Vec3::ZERO, dir_in_sensor: Vec3::Z, t_max_m: 1.0, pose: 0, pose_blend: 0.0 };
+        let ok = Beam {
+            origin_in_sensor: Vec3::ZERO,
+            dir_in_sensor: Vec3::Z,
+            t_max_m: 1.0,
+            pose: 0,
+            pose_blend: 0.0,
+            side_offset: 0.0,
+        };
         let err = |b: Beam| BeamSet::new(vec![ok, b], 1).unwrap_err().to_string();
         assert_eq!(err(Beam { pose: 1, ..ok }), "beam 1: pose 1 (allowed: 0 ..< 1)");
         // A blend needs the next pose.
         assert_eq!(err(Beam { pose_blend: 0.5, ..ok }), "beam 1: pose 1 (allowed: 0 ..< 1)");
+        assert!(err(Beam { side_offset: f32::NAN, ..ok }).contains("side_offset = NaN (allowed: finite)"));
         assert!(err(Beam { pose_blend: 1.0, ..ok }).contains("pose_blend = 1 (allowed: 0 <= blend < 1)"));
         assert!(err(Beam { dir_in_sensor: Vec3::new(0.0, 0.0, 2.0), ..ok }).contains("dir_in_sensor"));
         assert!(err(Beam { origin_in_sensor: Vec3::NAN, ..ok }).contains("origin_in_sensor"));

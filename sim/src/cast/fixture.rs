@@ -101,6 +101,7 @@ pub fn lidar_beams() -> super::BeamSet {
             t_max_m: f32::INFINITY,
             pose: 0,
             pose_blend: 0.0,
+            side_offset: 0.0,
         })
         .collect();
     super::BeamSet::new(beams, 1).expect("unit directions, one pose")

@@ -137,10 +137,10 @@ mod tests {
             for (k, f) in pipelined.iter().enumerate() {
                 let want = reference.frame(k);
                 for got in [&f.cloud, &beams.frame(k).cloud] {
-                    let agreement = crate::scan::Agreement::of(&want.cloud, got).unwrap();
-                    assert!(agreement.both_hit > 1000, "{agreement:?}");
                     let quantum = beams.measurements().iter().map(|m| m.range_quantum_m).fold(0.0, f32::max);
-                    let checked = crate::scan::AgreementContract::GPU.check(&agreement, quantum);
+                    let agreement = crate::scan::Agreement::of(&want.cloud, got, quantum).unwrap();
+                    assert!(agreement.both_hit > 1000, "{agreement:?}");
+                    let checked = crate::scan::AgreementContract::GPU.check(&agreement);
                     assert!(checked.is_ok(), "{name} frame {k}: {checked:?} {agreement:?}");
                 }
             }

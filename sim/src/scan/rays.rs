@@ -43,8 +43,7 @@ impl Scanner<'_> {
     /// sensor with at most [`MAX_KEY_POSES`] distinct shot times has a pose per shot time (the
     /// host's poses exactly); one with more (a VLP-16 fires every laser at its own time) has
     /// [`MAX_KEY_POSES`] key poses spread evenly over its shots, each beam blended between the two
-    /// around its time. Sub-ray directions are turned in the sensor frame, which a rigid pose
-    /// preserves.
+    /// around its time.
     ///
     /// [`Caster::cast_beams`]: crate::cast::Caster::cast_beams
     pub(super) fn device_beams(&self) -> Option<DeviceBeams> {
@@ -97,13 +96,20 @@ impl Scanner<'_> {
             for (f, &shot) in firings.iter().zip(shot_of) {
                 let Some(f) = f else { continue };
                 let (pose, pose_blend) = placed[s][shot as usize];
-                let dir = f.dir_in_sensor.normalize();
-                let beam = Beam { origin_in_sensor: f.origin_in_sensor, dir_in_sensor: dir, t_max_m, pose, pose_blend };
+                // The firing's own direction, which the host's rays normalise after turning it, and
+                // the divergence sub-rays turned sideways as `fill_row_beams` turns them.
+                let beam = Beam {
+                    origin_in_sensor: f.origin_in_sensor,
+                    dir_in_sensor: f.dir_in_sensor,
+                    t_max_m,
+                    pose,
+                    pose_blend,
+                    side_offset: 0.0,
+                };
                 beams.push(beam);
                 if sub_rays {
-                    let side = f.dir_in_sensor.cross(Vec3::Z).normalize_or_zero();
                     for sign in [-1.0f32, 1.0] {
-                        beams.push(Beam { dir_in_sensor: (dir + side * (sign * off)).normalize(), ..beam });
+                        beams.push(Beam { side_offset: sign * off, ..beam });
                     }
                 }
             }

@@ -4,12 +4,13 @@
 // main:       rays made on the host. input: 2 vec4 per ray: (origin.xyz, t_max), (dir.xyz, 0).
 // main_beams: rays made here from a beam set kept on the device and poses per frame. input: the
 //             beams, 3 vec4 each: (origin_in_sensor.xyz, t_max), (dir_in_sensor.xyz, pose bits),
-//             (pose_blend, 0, 0, 0); then from vec4 `pose_base` on, 3 vec4 per pose: the rows of
+//             (pose_blend, side_offset, 0, 0); then from vec4 `pose_base` on, 3 vec4 per pose: the rows of
 //             the 3 x 4 `world_from_sensor` (rotation | translation), `poses` per frame, frame
 //             after frame. Ray r of the call is beam (r % beams) of frame (r / beams) of the call,
 //             placed by pose `pose` blended linearly toward pose `pose + 1` by `pose_blend`: its
 //             origin is the blend applied to the beam's origin, its direction the blend applied
-//             to the beam's direction, normalised (as `BeamSet::ray` on the host).
+//             to the beam's direction, normalised, then turned sideways by `side_offset` (as
+//             `BeamSet::ray` on the host).
 // hits:       per ray of the batch (t bits, leaf-order triangle or MISS / OVERFLOW).
 
 struct Params {
@@ -54,7 +55,8 @@ fn main_beams(@builtin(global_invocation_id) gid: vec3<u32>) {
     let beam = r - frame * params.beams;
     let a = input[3u * beam];
     let b = input[3u * beam + 1u];
-    let blend = input[3u * beam + 2u].x;
+    let extra = input[3u * beam + 2u];
+    let blend = extra.x;
     let p = params.pose_base + 3u * (frame * params.poses + bitcast<u32>(b.w));
     var m0 = input[p];
     var m1 = input[p + 1u];
@@ -65,6 +67,21 @@ fn main_beams(@builtin(global_invocation_id) gid: vec3<u32>) {
         m2 = mix(m2, input[p + 5u], blend);
     }
     let o = vec3<f32>(dot(m0.xyz, a.xyz) + m0.w, dot(m1.xyz, a.xyz) + m1.w, dot(m2.xyz, a.xyz) + m2.w);
-    let d = normalize(vec3<f32>(dot(m0.xyz, b.xyz), dot(m1.xyz, b.xyz), dot(m2.xyz, b.xyz)));
+    let w = vec3<f32>(dot(m0.xyz, b.xyz), dot(m1.xyz, b.xyz), dot(m2.xyz, b.xyz));
+    // `w / |w|` as the host's `normalize` computes it (`w * (1 / sqrt(w . w))`): on a device whose
+    // `sqrt` and division are correctly rounded, the host's rays to the bit.
+    var d = w * (1.0 / sqrt(dot(w, w)));
+    if (extra.y != 0.0) {
+        // The host's `side = normalize_or_zero(pose * (dir x z))`, `d = normalize(d + side * offset)`.
+        let cross_z = vec3<f32>(b.y, -b.x, 0.0);
+        let s = vec3<f32>(dot(m0.xyz, cross_z), dot(m1.xyz, cross_z), dot(m2.xyz, cross_z));
+        let rcp = 1.0 / sqrt(dot(s, s));
+        var side = vec3<f32>(0.0);
+        if (rcp > 0.0 && rcp < 3.0e38) {
+            side = s * rcp;
+        }
+        let turned = d + side * extra.y;
+        d = turned * (1.0 / sqrt(dot(turned, turned)));
+    }
     hits[i] = trace(o, d, a.w);
 }

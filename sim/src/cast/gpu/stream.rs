@@ -264,7 +264,7 @@ impl Stream {
         for b in set.beams() {
             let (o, d) = (b.origin_in_sensor, b.dir_in_sensor);
             packed.extend_from_slice(&[o.x, o.y, o.z, b.t_max_m.min(f32::MAX), d.x, d.y, d.z, f32::from_bits(b.pose)]);
-            packed.extend_from_slice(&[b.pose_blend, 0.0, 0.0, 0.0]);
+            packed.extend_from_slice(&[b.pose_blend, b.side_offset, 0.0, 0.0]);
         }
         let size = set.beams().len() as u64 * BEAM_BYTES + (frames * set.poses_per_frame()) as u64 * POSE_BYTES;
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
