@@ -85,7 +85,7 @@ impl BeamSet {
             if !(b.dir_in_sensor.is_finite() && (b.dir_in_sensor.length() - 1.0).abs() < 1e-4) {
                 return Err(bad("dir_in_sensor", format!("{}", b.dir_in_sensor), "finite, unit length"));
             }
-            if !(b.t_max_m > 0.0) {
+            if b.t_max_m.is_nan() || b.t_max_m <= 0.0 {
                 return Err(bad("t_max_m", b.t_max_m.to_string(), "> 0 (infinity: unlimited)"));
             }
         }

@@ -133,7 +133,12 @@ mod tests {
             assert!(set.beams().len() >= fired, "{} beams for {fired} firings", set.beams().len());
             let reference = Scanner::new(&mesh, &rig, config).unwrap();
             let mut pipelined = Vec::new();
-            beams.scan_frames(0..3, |f| Ok::<(), ()>(pipelined.push(f))).unwrap();
+            beams
+                .scan_frames(0..3, |f| {
+                    pipelined.push(f);
+                    Ok::<(), ()>(())
+                })
+                .unwrap();
             for (k, f) in pipelined.iter().enumerate() {
                 let want = reference.frame(k);
                 for got in [&f.cloud, &beams.frame(k).cloud] {
