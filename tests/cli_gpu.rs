@@ -1,8 +1,9 @@
 //! `--backend gpu` keeps the agreement contract against the reference `--backend bvh`
-//! ([`sim::scan::AgreementContract::GPU`]: hit / miss on at least 99.99 % of cells, labels equal,
-//! ranges within 1 mm plus one range quantum) on every scene family, with every roof rig and the
-//! four-sensor LUX rig, moving (rays uploaded every frame) and standing (rays kept on the device),
-//! through `groundtruth bench agreement`; and `scan --backend gpu` writes complete files. On Mesa's
+//! ([`sim::scan::AgreementContract::GPU`]: hit / miss, labels, and ranges within 1 mm plus one
+//! range quantum, each on at least 99.99 % of cells) on every scene family, with every roof rig and
+//! the four-sensor LUX rig, moving (rays made on the device from beams and poses) and standing
+//! (rays kept on the device), through `groundtruth bench agreement`; `scan --backend gpu` and
+//! `dataset --backend gpu` (frames cast ahead in a pipeline) write complete files. On Mesa's
 //! lavapipe in CI. Without a GPU adapter the tests are skipped with a message, unless
 //! `GROUNDTRUTH_REQUIRE_GPU=1` makes that a failure.
 
@@ -115,6 +116,49 @@ fn gpu_scan_writes_complete_files() {
         for ext in ["bin", "label", "pcd"] {
             let name = format!("frame_{:06}.{ext}", fg["index"].as_u64().unwrap());
             assert!(std::fs::metadata(dir.path().join("gpu").join(&name)).unwrap().len() > 1000, "{name}");
+        }
+    }
+}
+
+#[test]
+fn gpu_dataset_writes_every_frame_of_every_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("dataset.toml");
+    let mut toml = String::new();
+    for id in 0..2 {
+        toml += &format!(
+            "[[sequences]]\nid = {id}\nscene = \"flat-objects\"\nseed = {}\nrig = \"vlp16-roof\"\nframes = 5\nspeed_m_per_s = 8.0\n\n",
+            id + 1
+        );
+    }
+    std::fs::write(&config, toml).unwrap();
+    let dataset = |backend: &str| {
+        Command::new(BIN)
+            .args(["dataset", "--config"])
+            .arg(&config)
+            .args(["--backend", backend, "--out"])
+            .arg(dir.path().join(backend))
+            .output()
+            .unwrap()
+    };
+    let gpu = dataset("gpu");
+    if gpu_or_skip(&gpu).is_none() {
+        return;
+    }
+    assert!(gpu.status.success(), "{}", String::from_utf8_lossy(&gpu.stderr));
+    assert!(dataset("bvh").status.success());
+    for seq in ["00", "01"] {
+        for k in 0..5 {
+            let file = |backend: &str, sub: &str, ext: &str| {
+                dir.path().join(backend).join("sequences").join(seq).join(sub).join(format!("{k:06}.{ext}"))
+            };
+            // Same number of points (16 bytes each) within the contract, a label per point.
+            let (g, c) = (
+                std::fs::metadata(file("gpu", "velodyne", "bin")).unwrap().len(),
+                std::fs::metadata(file("bvh", "velodyne", "bin")).unwrap().len(),
+            );
+            assert!(g > 16_000 && (g as f64 - c as f64).abs() <= 16.0 * 3.0, "{seq}/{k}: {g} vs {c} bytes");
+            assert_eq!(std::fs::metadata(file("gpu", "labels", "label")).unwrap().len() * 4, g, "{seq}/{k}");
         }
     }
 }

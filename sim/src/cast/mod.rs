@@ -115,7 +115,10 @@ pub trait Caster: Send + Sync {
     /// frame after frame): the hits of every frame in turn, each in beam order. A device backend
     /// keeps the beams on the device and makes the rays there (its rays may differ from the host's
     /// in the last bits: [`crate::scan::AgreementContract`]); the default makes them on the host
-    /// ([`BeamSet::rays`]) and casts them with [`Caster::cast_all`].
+    /// ([`BeamSet::rays`]) and casts them with [`Caster::cast_all`]. A backend that
+    /// [`Caster::prefers_frames`] is called from the scanner's casting thread while rayon workers
+    /// may all be blocked waiting for it (`Scanner::scan_frames`): its `cast_beams` must not wait
+    /// on the rayon pool.
     fn cast_beams(&self, beams: &BeamSet, poses: &[glam::Affine3A]) -> Vec<Option<Hit>> {
         self.cast_all(&beams.rays(poses))
     }

@@ -380,10 +380,8 @@ impl<'a> Scanner<'a> {
             cloud.reset_cells(rows * cols..cloud.len());
         }
         let start_time_s = index as f64 * self.frame_period_s;
-        let (shot_poses, hits) = match ahead {
-            Some(a) => (a.shot_poses, Some(a.hits)),
-            None => (self.shot_poses(index), None),
-        };
+        let shot_poses = self.shot_poses(index);
+        let hits = ahead.map(|a| a.hits);
         let extra: Vec<Vec<ExtraEcho>> = if cols == 0 {
             Vec::new()
         } else {

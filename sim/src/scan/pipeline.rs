@@ -6,26 +6,26 @@
 //!
 //! [`Caster::cast_beams`]: crate::cast::Caster::cast_beams
 
-use std::ops::Range;
-
 use glam::Affine3A;
 
-use super::rays::ShotPose;
 use super::{Frame, Scanner};
 use crate::cast::Hit;
 
-/// A frame's shot poses and its hits, cast ahead of measuring.
+/// A frame's hits, cast ahead of measuring.
 pub(super) struct CastAhead {
-    pub(super) shot_poses: Vec<Vec<ShotPose>>,
     pub(super) hits: Vec<Option<Hit>>,
 }
 
 impl Scanner<'_> {
-    /// Scans `frames` in order and hands each to `each`; stops at the first error `each` returns and
+    /// Scans `frames` (frame indices, in the order given) and hands each to `each`; stops at the first error `each` returns and
     /// returns it. With a caster that makes rays on a device and a moving vehicle, the next frames
     /// are cast while this one is measured and handed over (module docs); otherwise frame after
     /// frame through [`Scanner::frame`]. Same frames either way.
-    pub fn scan_frames<E>(&self, frames: Range<usize>, mut each: impl FnMut(Frame) -> Result<(), E>) -> Result<(), E> {
+    pub fn scan_frames<E>(
+        &self,
+        frames: impl IntoIterator<Item = usize>,
+        mut each: impl FnMut(Frame) -> Result<(), E>,
+    ) -> Result<(), E> {
         let Some(beams) = &self.beam_set else {
             for k in frames {
                 each(self.frame(k))?;
@@ -34,19 +34,21 @@ impl Scanner<'_> {
         };
         let n = beams.set.beams().len();
         let per_call = beams.set.frames_per_call();
-        let frames: Vec<usize> = frames.collect();
+        let frames: Vec<usize> = frames.into_iter().collect();
         std::thread::scope(|scope| {
             // One call's frames in flight while the previous call's are measured.
             let (sender, receiver) = std::sync::mpsc::sync_channel::<Vec<(usize, CastAhead)>>(1);
             let frames = &frames;
+            // The casting thread uses no rayon pool: the caller may be a pool worker that blocks
+            // on the channel, and every other worker may be blocked the same way (a dataset's
+            // sequences), so work queued on the pool from here could wait for ever.
             scope.spawn(move || {
                 for call in frames.chunks(per_call) {
-                    let shot_poses: Vec<Vec<Vec<ShotPose>>> = call.iter().map(|&k| self.shot_poses(k)).collect();
                     let poses: Vec<Affine3A> = call.iter().flat_map(|&k| self.device_poses(beams, k)).collect();
                     let mut hits = self.caster.cast_beams(&beams.set, &poses);
                     let mut cast = Vec::with_capacity(call.len());
-                    for (i, (&k, shot_poses)) in call.iter().zip(shot_poses).enumerate().rev() {
-                        cast.push((k, CastAhead { shot_poses, hits: hits.split_off(i * n) }));
+                    for (i, &k) in call.iter().enumerate().rev() {
+                        cast.push((k, CastAhead { hits: hits.split_off(i * n) }));
                     }
                     cast.reverse();
                     // The receiver is gone when the caller stopped at an error.

@@ -345,6 +345,45 @@ fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bo
     };
     let mut counts = Counts { in_shard: mine.len() as u64, ..Counts::default() };
     match bag.as_mut() {
+        // A device caster: the frames cast ahead in a pipeline (several per device call), each
+        // written on the pool while the next ones are measured.
+        None if scanner.caster().prefers_frames() => {
+            let todo: Vec<usize> = mine.iter().copied().filter(|&k| !(resume && done(k))).collect();
+            counts.skipped = (mine.len() - todo.len()) as u64;
+            let written = std::sync::Mutex::new(Vec::new());
+            // Frames waiting to be written at most (beyond it this thread writes the frame itself),
+            // so a slow disk cannot pile up frames in memory.
+            let (pending, max_pending) = (std::sync::atomic::AtomicUsize::new(0), 2 * rayon::current_num_threads());
+            let cast = rayon::scope(|scope| {
+                scanner.scan_frames(todo.iter().copied(), |mut frame| -> anyhow::Result<()> {
+                    crate::cli::common::check_device(scanner.caster())?;
+                    vary(&mut frame.cloud, s, frame.index)?;
+                    let (written, write_frame, pending) = (&written, &write_frame, &pending);
+                    let write = move |frame: sim::scan::Frame| {
+                        let result = write_frame(frame.index, &frame);
+                        written.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(result);
+                    };
+                    if pending.load(std::sync::atomic::Ordering::Relaxed) >= max_pending {
+                        write(frame);
+                    } else {
+                        pending.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        scope.spawn(move |_| {
+                            write(frame);
+                            pending.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
+                        });
+                    }
+                    Ok(())
+                })
+            });
+            let points = written
+                .into_inner()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .into_iter()
+                .collect::<anyhow::Result<Vec<u64>>>()?;
+            cast?;
+            counts.written = points.len() as u64;
+            counts.points = points.iter().sum();
+        }
         // Frames in parallel, each written as it is made.
         None => {
             let todo: Vec<usize> = mine.iter().copied().filter(|&k| !(resume && done(k))).collect();

@@ -1,6 +1,10 @@
-//! The GPU backend (cargo feature `gpu`): the obvhs BVH2 built on the CPU, flattened into storage
-//! buffers and traversed by a WGSL compute shader (`cast.wgsl`, one ray per invocation, a 64-entry
-//! stack, nearer child first) with the watertight triangle test of [`super::watertight`] in f32.
+//! The GPU backend (cargo feature `gpu`): an obvhs BVH built on the CPU, flattened into storage
+//! buffers and traversed by a WGSL compute shader (`cast.wgsl`, one ray per invocation) with the
+//! watertight triangle test of [`super::watertight`] in f32. The BVH ([`GpuBvh`], or
+//! `GROUNDTRUTH_GPU_BVH`): by default the compressed 8-wide BVH (CWBVH) obvhs converts from its
+//! BVH2 (`cwbvh.wgsl`, a stack of node groups, children in the ray octant's order; measured on
+//! lavapipe 2.2 to 2.5 times the BVH2's kernel speed), or that BVH2 itself (`bvh2.wgsl`, a
+//! 64-entry stack, nearer child first).
 //! It runs on any Vulkan, Metal or DX12 device through wgpu, including Mesa's software Vulkan
 //! (lavapipe) without a GPU.
 //!
@@ -23,6 +27,7 @@
 //!   because rays transformed on the device (its `sqrt` and division are not correctly rounded)
 //!   would not be the same bits as the CPU backends' and scans would no longer match them.
 
+mod cwbvh;
 mod device;
 mod scene;
 mod stream;
@@ -62,6 +67,71 @@ pub enum GpuError {
         /// The device's storage-binding limit, bytes.
         limit_bytes: u64,
     },
+    /// An environment variable of the backend has a value it does not know.
+    #[error("{variable} is `{value}`; allowed: {allowed}")]
+    Env {
+        /// The variable.
+        variable: &'static str,
+        /// Its value.
+        value: String,
+        /// The values it may take.
+        allowed: &'static str,
+    },
+}
+
+/// The BVH layout the GPU traverses (both are built from the same obvhs BVH2; the hits are the
+/// same but for ties and the rounding of the box tests).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum GpuBvh {
+    /// The binary BVH, leaves of up to 4 triangles, nearer child first (`bvh2.wgsl`).
+    Bvh2,
+    /// The compressed 8-wide BVH (CWBVH, Ylitie et al. 2017: 80-byte nodes, child boxes quantized
+    /// to 8 bits, leaves of up to 3 triangles, children in the ray octant's order; `cwbvh.wgsl`).
+    /// The default: the faster (on lavapipe, `bench raycast`: 2.2 times the BVH2's kernel speed on
+    /// `city` with `hdl64e-roof`, 2.4 times on the 1.3 M-triangle fixture terrain).
+    #[default]
+    Cwbvh,
+}
+
+impl GpuBvh {
+    /// The environment variable [`GpuCaster::new`] takes the layout from: `bvh2` or `cwbvh`.
+    pub const ENV: &'static str = "GROUNDTRUTH_GPU_BVH";
+
+    /// The layout [`GpuBvh::ENV`] names, `None` where it is unset or empty; [`GpuError::Env`] for
+    /// another value.
+    pub fn from_env() -> Result<Option<Self>, GpuError> {
+        match std::env::var(Self::ENV) {
+            Ok(v) if !v.trim().is_empty() => v.parse().map(Some),
+            _ => Ok(None),
+        }
+    }
+
+    /// The layout's name, as [`GpuBvh::ENV`] takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bvh2 => "bvh2",
+            Self::Cwbvh => "cwbvh",
+        }
+    }
+}
+
+impl std::fmt::Display for GpuBvh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for GpuBvh {
+    type Err = GpuError;
+
+    /// `bvh2` or `cwbvh` (case-insensitive, surrounding blanks ignored).
+    fn from_str(s: &str) -> Result<Self, GpuError> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "bvh2" => Ok(Self::Bvh2),
+            "cwbvh" => Ok(Self::Cwbvh),
+            _ => Err(GpuError::Env { variable: Self::ENV, value: s.to_owned(), allowed: "bvh2, cwbvh" }),
+        }
+    }
 }
 
 /// Options of [`GpuCaster::with_options`].
@@ -71,6 +141,13 @@ pub struct GpuOptions {
     /// the scene over more bindings and the rays into smaller batches, as a device with that
     /// limit would (tests use it to exercise the splits on a small scene).
     pub max_binding_bytes: Option<u64>,
+    /// The BVH layout to traverse.
+    pub bvh: GpuBvh,
+    /// Largest binding for the BVH nodes alone, bytes (`None`: as the others). Tests only: the
+    /// CWBVH's nodes take a fifth of its triangles' bytes, so no binding limit that lets the
+    /// triangles fit their 4 bindings splits its nodes; this does.
+    #[doc(hidden)]
+    pub max_node_binding_bytes: Option<u64>,
 }
 
 /// Ray casting on a GPU through wgpu (module docs).
@@ -86,18 +163,22 @@ pub struct GpuCaster {
 
 impl GpuCaster {
     /// Builds the BVH of `mesh`, uploads it and compiles the shader on the adapter wgpu's
-    /// environment variables choose (module docs).
+    /// environment variables choose (module docs), in the layout [`GpuBvh::ENV`] names (default
+    /// [`GpuBvh::default`]; [`GpuError::Env`] for a value it does not know).
     pub fn new(mesh: &SceneMesh) -> Result<Self, GpuError> {
-        Self::with_options(mesh, GpuOptions::default())
+        let bvh = GpuBvh::from_env()?.unwrap_or_default();
+        Self::with_options(mesh, GpuOptions { bvh, ..GpuOptions::default() })
     }
 
-    /// [`GpuCaster::new`] with `options`.
+    /// [`GpuCaster::new`] with `options` (the layout as they say, whatever the environment).
     pub fn with_options(mesh: &SceneMesh, options: GpuOptions) -> Result<Self, GpuError> {
         let mut gpu = device::Gpu::new()?;
         let max_binding_bytes =
             options.max_binding_bytes.map_or(gpu.max_binding_bytes, |b| b.clamp(256, gpu.max_binding_bytes));
         gpu.max_binding_bytes = max_binding_bytes;
-        let scene = scene::SceneBuffers::new(&gpu, mesh, max_binding_bytes)?;
+        let node_binding_bytes =
+            options.max_node_binding_bytes.map_or(max_binding_bytes, |b| b.clamp(256, max_binding_bytes));
+        let scene = scene::SceneBuffers::new(&gpu, mesh, (node_binding_bytes, max_binding_bytes), options.bvh)?;
         let stream = Mutex::new(stream::Stream::new(&gpu));
         Ok(Self { gpu, scene, cpu: BvhCaster::new(mesh), stream, max_binding_bytes })
     }
@@ -105,6 +186,11 @@ impl GpuCaster {
     /// The adapter in use: name, backend and device type.
     pub fn adapter(&self) -> &str {
         &self.gpu.description
+    }
+
+    /// The BVH layout in use.
+    pub fn bvh(&self) -> GpuBvh {
+        self.scene.bvh
     }
 
     /// The largest storage binding in use, bytes.
@@ -196,7 +282,12 @@ impl Caster for GpuCaster {
         let mut stream = self.lock();
         if stream.cast_beams(&self.gpu, &self.scene, beams, poses, &mut raw).is_err() {
             drop(stream);
-            return self.cast_all(&beams.rays(poses));
+            // Made on this thread: callers may be casting threads that must not wait on a pool.
+            let (n, per) = (beams.beams().len(), beams.poses_per_frame());
+            let rays: Vec<Ray> = (0..n * beams.frames_in(poses))
+                .map(|r| beams.ray(r % n, &poses[r / n * per..(r / n + 1) * per]))
+                .collect();
+            return self.cast_all(&rays);
         }
         let (n, per) = (beams.beams().len(), beams.poses_per_frame());
         raw.into_iter()
