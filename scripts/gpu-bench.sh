@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The GPU figures of docs/scanning.md in one JSON document, for anyone with a GPU (issue 38):
-# the adapter; `bench raycast` end to end and the kernel alone, `--backend gpu` against the same
-# host's all-core `bvh`, on fixture-terrain (1.3 M triangles, 128 x 2048 rays), city with
+# the adapter; `bench raycast` end to end and the kernel alone, `--backend gpu` (with the CWBVH and
+# the BVH2 layout, `GROUNDTRUTH_GPU_BVH`) against the same host's all-core `bvh`, on fixture-terrain (1.3 M triangles, 128 x 2048 rays), city with
 # os1-128-roof and forest-dense with hdl64e-roof; `scan` of 100 moving os1-128-roof city frames and
 # `dataset` of 1,000 hdl64e-roof city frames, wall time for both backends; and the agreement
 # contract (`bench agreement`) on city and forest-dense, with and without measurement effects.
@@ -21,8 +21,12 @@ log() { echo "[gpu-bench] $*" >&2; }
 # Seconds of wall time of a command (its output discarded).
 wall() { local t0 t1; t0=$(date +%s.%N); "$@" >/dev/null; t1=$(date +%s.%N); python3 -c "print(round($t1 - $t0, 3))"; }
 
-raycast() { # scene rig frames backend
-  "$BIN" bench raycast --scene "$1" --rig "$2" --frames "$3" --backend "$4"
+raycast() { # scene rig frames backend (the GPU's BVH layout from $layout)
+  if [ "$4" = gpu ]; then
+    GROUNDTRUTH_GPU_BVH=$layout "$BIN" bench raycast --scene "$1" --rig "$2" --frames "$3" --backend gpu
+  else
+    "$BIN" bench raycast --scene "$1" --rig "$2" --frames "$3" --backend "$4"
+  fi
 }
 
 out="$work/out.json"
@@ -34,11 +38,17 @@ echo "\"raycast\": [" >> "$out"
 first=1
 for spec in "fixture-terrain fixture-128x2048 $(n 400)" "city os1-128-roof $(n 200)" "forest-dense hdl64e-roof $(n 200)"; do
   set -- $spec
-  for backend in gpu bvh; do
-    log "bench raycast $1 $2 $3 frames, $backend"
+  # The GPU with each BVH layout (the default first), then the CPU.
+  for run in gpu:cwbvh gpu:bvh2 bvh:-; do
+    backend=${run%%:*} layout=${run#*:}
+    log "bench raycast $1 $2 $3 frames, $backend $layout"
     [ $first = 1 ] || echo "," >> "$out"
     first=0
-    raycast "$1" "$2" "$3" "$backend" >> "$out"
+    if [ "$layout" = - ]; then
+      raycast "$1" "$2" "$3" "$backend" >> "$out"
+    else
+      raycast "$1" "$2" "$3" "$backend" | python3 -c "import json,sys; d=json.load(sys.stdin); d['gpu_bvh']='$layout'; print(json.dumps(d))" >> "$out"
+    fi
   done
 done
 echo "]," >> "$out"
@@ -77,13 +87,16 @@ python3 - "$out" <<'PY'
 import json, sys
 doc = json.load(open(sys.argv[1]))
 def pair(scene):
-    # Each scene's runs: the gpu one first, then bvh (the order the script ran them in).
-    gpu, bvh = [r for r in doc["raycast"] if r["geometry"].startswith(scene)][:2]
+    # Each scene's runs in the order the script ran them: gpu with cwbvh, gpu with bvh2, bvh.
+    cw, b2, bvh = [r for r in doc["raycast"] if r["geometry"].startswith(scene)][:3]
+    kernel = lambda r: (r.get("device") or {}).get("kernel_rays_per_s")
     return {
-        "gpu_rays_per_s": gpu["rays_per_s"],
-        "gpu_kernel_rays_per_s": (gpu.get("device") or {}).get("kernel_rays_per_s"),
+        "gpu_rays_per_s": cw["rays_per_s"],
+        "gpu_kernel_rays_per_s": kernel(cw),
+        "gpu_bvh2_rays_per_s": b2["rays_per_s"],
+        "gpu_bvh2_kernel_rays_per_s": kernel(b2),
         "bvh_rays_per_s": bvh["rays_per_s"],
-        "gpu_over_bvh": gpu["rays_per_s"] / bvh["rays_per_s"],
+        "gpu_over_bvh": cw["rays_per_s"] / bvh["rays_per_s"],
     }
 doc["summary"] = {
     "raycast": {s: pair(s) for s in ["fixture-terrain", "city", "forest-dense"]},

@@ -419,13 +419,15 @@ fn gpu_matches_bvh() {
 #[cfg(feature = "gpu")]
 #[test]
 fn gpu_splits_scene_and_rays_over_bindings() {
-    use sim::cast::gpu::GpuOptions;
+    use sim::cast::gpu::{GpuBvh, GpuOptions};
     let mesh = random_scene(7);
-    let Some(whole) = gpu_caster(&mesh, GpuOptions::default()) else { return };
+    // The BVH2: the CWBVH's nodes are too few to split while its triangles fit (`gpu_cwbvh.rs`).
+    let bvh2 = GpuOptions { bvh: GpuBvh::Bvh2, ..Default::default() };
+    let Some(whole) = gpu_caster(&mesh, bvh2) else { return };
     let (node_bytes, tri_bytes) = whole.scene_bytes();
     // Bindings of a power of two of nodes that holds half of them or more: exactly 2 node bindings.
     let limit = (node_bytes / 2).next_power_of_two().max(tri_bytes.div_ceil(4).next_power_of_two() * 3 / 2);
-    let split = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit) }).expect("an adapter");
+    let split = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit), ..bvh2 }).expect("an adapter");
     let (nodes, tris) = split.bindings_used();
     eprintln!("limit {limit} B: scene {node_bytes} + {tri_bytes} B in {nodes} node and {tris} triangle bindings");
     assert!(nodes == 2 && (2..=4).contains(&tris), "{nodes} node and {tris} triangle bindings");
@@ -437,9 +439,12 @@ fn gpu_splits_scene_and_rays_over_bindings() {
     let expected = BvhCaster::new(&mesh).cast_all(&rays);
     assert_agrees(&mesh, &rays, &expected, &got);
     // A scene that needs more bindings than the shader has is refused with the sizes.
-    let err = sim::cast::gpu::GpuCaster::with_options(&mesh, GpuOptions { max_binding_bytes: Some(256) })
-        .err()
-        .expect("too large");
+    let err = sim::cast::gpu::GpuCaster::with_options(
+        &mesh,
+        GpuOptions { max_binding_bytes: Some(256), ..Default::default() },
+    )
+    .err()
+    .expect("too large");
     assert!(err.to_string().contains("bytes"), "{err}");
 }
 
@@ -522,10 +527,12 @@ fn gpu_makes_rays_from_beams_and_poses() {
     assert_eq!(gpu.stats().upload_bytes - up0 - up1, 48 * poses.len() as u64);
     // Bindings that hold the beams and one or two frames' poses: the frames go in chunks.
     let limit = 48 * (rings * cols) as u64 + 48 * keys as u64 * 3 / 2;
-    let small = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit) }).expect("an adapter");
+    let small =
+        gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit), ..Default::default() }).expect("an adapter");
     assert_eq!(small.cast_beams(&set, &poses), got);
     // Bindings too small for the beams: the rays are made on the host instead, same hits.
-    let tiny = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(32 * (rings * cols) as u64) });
+    let tiny =
+        gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(32 * (rings * cols) as u64), ..Default::default() });
     let tiny = tiny.expect("an adapter");
     let on_host = tiny.cast_beams(&set, &poses);
     assert_agrees(&mesh, &rays, &expected, &on_host);

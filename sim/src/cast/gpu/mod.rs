@@ -3,7 +3,7 @@
 //! watertight triangle test of [`super::watertight`] in f32. The BVH ([`GpuBvh`], or
 //! `GROUNDTRUTH_GPU_BVH`): by default the compressed 8-wide BVH (CWBVH) obvhs converts from its
 //! BVH2 (`cwbvh.wgsl`, a stack of node groups, children in the ray octant's order; measured on
-//! lavapipe 2.2 to 2.5 times the BVH2's kernel speed), or that BVH2 itself (`bvh2.wgsl`, a
+//! lavapipe 2.2 to 2.4 times the BVH2's kernel speed), or that BVH2 itself (`bvh2.wgsl`, a
 //! 64-entry stack, nearer child first).
 //! It runs on any Vulkan, Metal or DX12 device through wgpu, including Mesa's software Vulkan
 //! (lavapipe) without a GPU.
