@@ -47,7 +47,9 @@ fn the_gpu_keeps_the_agreement_contract_on_every_scene_family() {
         let rig = rigs[k % rigs.len()];
         for speed in ["8", "0"] {
             let out = Command::new(BIN)
-                .args(["bench", "agreement", "--scene", scene, "--rig", rig, "--frames", "1", "--speed", speed])
+                // Two frames: at least 10,000 cells both hit even for the LUX, so that the contract's
+                // 1-in-10,000 shares can be told apart from a single cell.
+                .args(["bench", "agreement", "--scene", scene, "--rig", rig, "--frames", "2", "--speed", speed])
                 .args(["--seed", &(k + 1).to_string()])
                 .output()
                 .unwrap();

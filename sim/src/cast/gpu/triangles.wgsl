@@ -102,6 +102,20 @@ fn tri_ray(o: vec3<f32>, d: vec3<f32>) -> TriRay {
     return TriRay(o, kx, ky, kz, axis(d, kx) * sz, axis(d, ky) * sz, sz);
 }
 
+// `a b - c d` nearly as exactly as in f64, rounded to f32: each product's rounding error from a
+// fused multiply-add and the difference's from Knuth's two-sum (a device whose `fma` is not fused
+// gives the plain f32 value).
+fn diff_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
+    let p = a * b;
+    let q = c * d;
+    let ep = fma(a, b, -p);
+    let eq = fma(c, d, -q);
+    let s = p - q;
+    let z = s - p;
+    let es = (p - (s - z)) + (-q - z);
+    return s + (es + (ep - eq));
+}
+
 // The closest hit so far: its distance (the ray's t_max before any) and leaf-order triangle.
 struct Closest {
     t: f32,
@@ -123,9 +137,17 @@ fn closest_triangle(r: TriRay, p: u32, best: Closest) -> Closest {
     let by = axis(vb, r.ky) - r.sy * bz;
     let cx = axis(vc, r.kx) - r.sx * cz;
     let cy = axis(vc, r.ky) - r.sy * cz;
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
+    var u = cx * by - cy * bx;
+    var v = ax * cy - ay * cx;
+    var w = bx * ay - by * ax;
+    // An edge function exactly 0 in f32 (a ray through an edge or a vertex): again with the
+    // products' rounding errors, as the host's f64 fallback does, so the ray goes to the triangle
+    // it truly enters there too.
+    if (u == 0.0 || v == 0.0 || w == 0.0) {
+        u = diff_of_products(cx, by, cy, bx);
+        v = diff_of_products(ax, cy, ay, cx);
+        w = diff_of_products(bx, ay, by, ax);
+    }
     if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) {
         return best;
     }
