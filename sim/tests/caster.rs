@@ -2,60 +2,18 @@
 //! watertightness on grid edges and vertices, analytic plane distances, and thread-count
 //! independence of `cast_all`.
 
-use glam::{Affine3A, Quat, Vec3};
+mod common;
+
+use glam::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use sim::cast::watertight::intersect_triangle;
 use sim::cast::{BvhCaster, BvhLayout, BvhOptions, Caster, Hit, ParryCaster, Ray, fixture};
 use sim::{SceneMesh, SemanticClass, Surface};
 
-/// Random scene: a bumpy 64 x 64-cell heightfield and 40 random (rotated) boxes.
-fn random_scene(seed: u64) -> SceneMesh {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut m = SceneMesh::new();
-    let bumps: Vec<(f32, f32, f32)> = (0..12)
-        .map(|_| (rng.random_range(-30.0..30.0), rng.random_range(-30.0..30.0), rng.random_range(-2.0..3.0)))
-        .collect();
-    m.push_heightfield(
-        (-32.0, -32.0),
-        1.0,
-        (64, 64),
-        |x, y| bumps.iter().map(|&(bx, by, h)| h * (-((x - bx).powi(2) + (y - by).powi(2)) / 40.0).exp()).sum(),
-        |_, _| Surface::stuff(SemanticClass::TERRAIN),
-    );
-    for i in 0..40 {
-        let c = Vec3::new(rng.random_range(-28.0..28.0), rng.random_range(-28.0..28.0), rng.random_range(-1.0..2.0));
-        let half = Vec3::new(rng.random_range(0.3..4.0), rng.random_range(0.3..4.0), rng.random_range(0.3..3.0));
-        let rot =
-            Quat::from_rotation_z(rng.random_range(0.0..6.3)) * Quat::from_rotation_x(rng.random_range(-0.3..0.3));
-        m.push_oriented_box(
-            Affine3A::from_rotation_translation(rot, c),
-            -half,
-            half,
-            Surface::object(SemanticClass::CAR, i + 1),
-        );
-    }
-    m
-}
-
-fn random_rays(seed: u64, n: usize) -> Vec<Ray> {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            let origin =
-                Vec3::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0), rng.random_range(-1.0..12.0));
-            let dir = loop {
-                let d =
-                    Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..0.6));
-                if d.length() > 0.1 && d.length() <= 1.0 {
-                    break d.normalize();
-                }
-            };
-            let t_max = if rng.random_range(0.0..1.0) < 0.2 { rng.random_range(1.0..30.0) } else { f32::INFINITY };
-            Ray { origin, dir, t_max }
-        })
-        .collect()
-}
+#[cfg(feature = "gpu")]
+use common::{assert_agrees, gpu_caster, gpu_test_rays, spinning_beams};
+use common::{random_rays, random_scene};
 
 fn compare(mesh: &SceneMesh, rays: &[Ray], a: &[Option<Hit>], b: &[Option<Hit>]) -> (usize, usize) {
     let mut hits = 0;
@@ -316,73 +274,6 @@ fn empty_scene_never_hits() {
     assert_eq!(BvhCaster::new(&mesh).cast_all(&[r; 3]), vec![None; 3]);
 }
 
-/// The GPU caster, or `None` (skipped, with a message) without an adapter unless
-/// `GROUNDTRUTH_REQUIRE_GPU=1` (CI, on Mesa's lavapipe) makes that a failure.
-#[cfg(feature = "gpu")]
-fn gpu_caster(mesh: &SceneMesh, options: sim::cast::gpu::GpuOptions) -> Option<sim::cast::gpu::GpuCaster> {
-    use sim::cast::gpu::{GpuCaster, GpuError};
-    match GpuCaster::with_options(mesh, options) {
-        Ok(g) => Some(g),
-        Err(e @ GpuError::NoAdapter(_)) if std::env::var("GROUNDTRUTH_REQUIRE_GPU").as_deref() != Ok("1") => {
-            eprintln!("GPU test skipped: {e}");
-            None
-        }
-        Err(e) => panic!("GPU backend: {e}"),
-    }
-}
-
-/// Random rays and a sensor 4 m above the random scene's terrain: 32 rings x 1,024 columns.
-#[cfg(feature = "gpu")]
-fn gpu_test_rays() -> Vec<Ray> {
-    let mut rays = random_rays(11, 60_000);
-    for ring in 0..32 {
-        let elevation = (-25.0f32 + ring as f32 * 1.2).to_radians();
-        for col in 0..1024 {
-            let azimuth = col as f32 * std::f32::consts::TAU / 1024.0;
-            let dir = Vec3::new(elevation.cos() * azimuth.cos(), elevation.cos() * azimuth.sin(), elevation.sin());
-            rays.push(Ray { origin: Vec3::new(0.3, -0.2, 4.0), dir, t_max: 120.0 });
-        }
-    }
-    rays
-}
-
-/// Asserts the GPU's hits `got` against the CPU's `expected`: hit / miss identical on at least
-/// 99.99 % of the rays, distances within 1e-3 m, the same triangle except where the two are tied.
-/// Returns (hits, ties, disagreements).
-#[cfg(feature = "gpu")]
-fn assert_agrees(
-    mesh: &SceneMesh,
-    rays: &[Ray],
-    expected: &[Option<Hit>],
-    got: &[Option<Hit>],
-) -> (usize, usize, usize) {
-    let (mut disagree, mut hits, mut ties) = (0usize, 0usize, 0usize);
-    for (i, (x, y)) in expected.iter().zip(got).enumerate() {
-        match (x, y) {
-            (Some(x), Some(y)) => {
-                hits += 1;
-                assert!((x.t - y.t).abs() <= 1e-3, "ray {i}: t {} (cpu) vs {} (gpu)", x.t, y.t);
-                if x.triangle != y.triangle {
-                    let ty = intersect_triangle(&rays[i], mesh.triangle(y.triangle as usize));
-                    assert!(
-                        ty.is_some_and(|t| (t - x.t).abs() <= 1e-3),
-                        "ray {i}: gpu triangle {} not tied",
-                        y.triangle
-                    );
-                    ties += 1;
-                }
-            }
-            (None, None) => {}
-            _ => disagree += 1,
-        }
-    }
-    let n = rays.len();
-    assert_eq!(got.len(), n);
-    assert!(hits > n / 3, "{hits} hits of {n}");
-    assert!(disagree as f64 <= 1e-4 * n as f64, "{disagree} of {n} rays disagree on hit / miss");
-    (hits, ties, disagree)
-}
-
 /// The wgpu backend against the production BVH on the random scene and on a spinning sensor's
 /// rays (skipped without an adapter, see [`gpu_caster`]).
 #[cfg(feature = "gpu")]
@@ -479,41 +370,14 @@ fn gpu_keeps_resident_rays_on_the_device() {
 #[cfg(feature = "gpu")]
 #[test]
 fn gpu_makes_rays_from_beams_and_poses() {
-    use glam::Affine3A;
     use sim::cast::gpu::GpuOptions;
-    use sim::cast::{Beam, BeamSet};
     let mesh = random_scene(7);
     let Some(gpu) = gpu_caster(&mesh, GpuOptions::default()) else { return };
-    let (rings, cols, frames) = (32usize, 1024usize, 5usize);
-    let mut beams = Vec::new();
-    for ring in 0..rings {
-        let elevation = (-25.0f32 + ring as f32 * 1.2).to_radians();
-        for col in 0..cols {
-            let azimuth = col as f32 * std::f32::consts::TAU / cols as f32;
-            let dir = Vec3::new(elevation.cos() * azimuth.cos(), elevation.cos() * azimuth.sin(), elevation.sin());
-            beams.push(Beam {
-                origin_in_sensor: Vec3::new(0.05, 0.0, 0.0),
-                dir_in_sensor: dir,
-                t_max_m: 120.0,
-                pose: (col / 8) as u32,
-                pose_blend: (col % 8) as f32 / 8.0,
-                side_offset: 0.0,
-            });
-        }
-    }
-    // A pose every 8 columns (and one after the last), blended in between.
-    let keys = cols / 8 + 1;
-    let set = BeamSet::new(beams, keys).unwrap();
-    // Each frame drives 1.5 m and turns; each key pose a little further along.
-    let poses: Vec<Affine3A> = (0..frames * keys)
-        .map(|i| {
-            let s = (i / keys) as f32 + (i % keys) as f32 / (keys - 1) as f32;
-            Affine3A::from_translation(Vec3::new(0.3 + 1.5 * s, -0.2 + 0.1 * s, 4.0))
-                * Affine3A::from_rotation_z(0.05 * s)
-        })
-        .collect();
+    let frames = 5;
+    let (set, poses) = spinning_beams(frames);
+    let (beams, keys) = (set.beams().len(), set.poses_per_frame());
     let rays = set.rays(&poses);
-    assert_eq!(rays.len(), frames * rings * cols);
+    assert_eq!(rays.len(), frames * 32 * 1024);
     let expected = BvhCaster::new(&mesh).cast_all(&rays);
     let up0 = gpu.stats().upload_bytes;
     let got = gpu.cast_beams(&set, &poses);
@@ -521,18 +385,17 @@ fn gpu_makes_rays_from_beams_and_poses() {
     let up1 = gpu.stats().upload_bytes - up0;
     eprintln!("{} rays from beams: {hits} hits, {ties} ties, {disagree} disagreements, {up1} B up", rays.len());
     // The beams (48 B each) once and the poses (48 B each), not 32 B per ray.
-    assert_eq!(up1, 48 * (rings * cols) as u64 + 48 * poses.len() as u64);
+    assert_eq!(up1, 48 * beams as u64 + 48 * poses.len() as u64);
     // Again: only the poses go up.
     assert_eq!(gpu.cast_beams(&set, &poses), got);
     assert_eq!(gpu.stats().upload_bytes - up0 - up1, 48 * poses.len() as u64);
     // Bindings that hold the beams and one or two frames' poses: the frames go in chunks.
-    let limit = 48 * (rings * cols) as u64 + 48 * keys as u64 * 3 / 2;
+    let limit = 48 * beams as u64 + 48 * keys as u64 * 3 / 2;
     let small =
         gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(limit), ..Default::default() }).expect("an adapter");
     assert_eq!(small.cast_beams(&set, &poses), got);
     // Bindings too small for the beams: the rays are made on the host instead, same hits.
-    let tiny =
-        gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(32 * (rings * cols) as u64), ..Default::default() });
+    let tiny = gpu_caster(&mesh, GpuOptions { max_binding_bytes: Some(32 * beams as u64), ..Default::default() });
     let tiny = tiny.expect("an adapter");
     let on_host = tiny.cast_beams(&set, &poses);
     assert_agrees(&mesh, &rays, &expected, &on_host);

@@ -5,134 +5,21 @@
 //! message, unless `GROUNDTRUTH_REQUIRE_GPU=1` (CI, on Mesa's lavapipe) makes that a failure.
 #![cfg(feature = "gpu")]
 
-use glam::{Affine3A, Quat, Vec3};
+mod common;
+
+use glam::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use sim::cast::gpu::{GpuBvh, GpuCaster, GpuError, GpuOptions};
-use sim::cast::watertight::intersect_triangle;
-use sim::cast::{Beam, BeamSet, BvhCaster, Caster, Hit, Ray};
+use sim::cast::{BvhCaster, Caster, Hit, Ray};
 use sim::{SceneMesh, SemanticClass, Surface};
 
-/// Random scene: a bumpy 64 x 64-cell heightfield and 40 random (rotated) boxes (as in
-/// `caster.rs`).
-fn random_scene(seed: u64) -> SceneMesh {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut m = SceneMesh::new();
-    let bumps: Vec<(f32, f32, f32)> = (0..12)
-        .map(|_| (rng.random_range(-30.0..30.0), rng.random_range(-30.0..30.0), rng.random_range(-2.0..3.0)))
-        .collect();
-    m.push_heightfield(
-        (-32.0, -32.0),
-        1.0,
-        (64, 64),
-        |x, y| bumps.iter().map(|&(bx, by, h)| h * (-((x - bx).powi(2) + (y - by).powi(2)) / 40.0).exp()).sum(),
-        |_, _| Surface::stuff(SemanticClass::TERRAIN),
-    );
-    for i in 0..40 {
-        let c = Vec3::new(rng.random_range(-28.0..28.0), rng.random_range(-28.0..28.0), rng.random_range(-1.0..2.0));
-        let half = Vec3::new(rng.random_range(0.3..4.0), rng.random_range(0.3..4.0), rng.random_range(0.3..3.0));
-        let rot =
-            Quat::from_rotation_z(rng.random_range(0.0..6.3)) * Quat::from_rotation_x(rng.random_range(-0.3..0.3));
-        m.push_oriented_box(
-            Affine3A::from_rotation_translation(rot, c),
-            -half,
-            half,
-            Surface::object(SemanticClass::CAR, i + 1),
-        );
-    }
-    m
-}
-
-/// Random rays over the random scene, a fifth of them with a finite range.
-fn random_rays(seed: u64, n: usize) -> Vec<Ray> {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            let origin =
-                Vec3::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0), rng.random_range(-1.0..12.0));
-            let dir = loop {
-                let d =
-                    Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..0.6));
-                if d.length() > 0.1 && d.length() <= 1.0 {
-                    break d.normalize();
-                }
-            };
-            let t_max = if rng.random_range(0.0..1.0) < 0.2 { rng.random_range(1.0..30.0) } else { f32::INFINITY };
-            Ray { origin, dir, t_max }
-        })
-        .collect()
-}
-
-/// Random rays and a sensor 4 m above the random scene's terrain: 32 rings x 1,024 columns.
-fn test_rays() -> Vec<Ray> {
-    let mut rays = random_rays(11, 60_000);
-    for ring in 0..32 {
-        let elevation = (-25.0f32 + ring as f32 * 1.2).to_radians();
-        for col in 0..1024 {
-            let azimuth = col as f32 * std::f32::consts::TAU / 1024.0;
-            let dir = Vec3::new(elevation.cos() * azimuth.cos(), elevation.cos() * azimuth.sin(), elevation.sin());
-            rays.push(Ray { origin: Vec3::new(0.3, -0.2, 4.0), dir, t_max: 120.0 });
-        }
-    }
-    rays
-}
+use common::{assert_agrees, gpu_test_rays, random_scene, spinning_beams};
 
 /// The caster in layout `bvh`, or `None` (skipped, with a message) without an adapter unless
 /// `GROUNDTRUTH_REQUIRE_GPU=1`.
 fn gpu_caster(mesh: &SceneMesh, bvh: GpuBvh, max_binding_bytes: Option<u64>) -> Option<GpuCaster> {
-    options_caster(mesh, GpuOptions { bvh, max_binding_bytes, ..GpuOptions::default() })
-}
-
-/// [`gpu_caster`] with `options`.
-fn options_caster(mesh: &SceneMesh, options: GpuOptions) -> Option<GpuCaster> {
-    let bvh = options.bvh;
-    match GpuCaster::with_options(mesh, options) {
-        Ok(g) => {
-            assert_eq!(g.bvh(), bvh);
-            Some(g)
-        }
-        Err(e @ GpuError::NoAdapter(_)) if std::env::var("GROUNDTRUTH_REQUIRE_GPU").as_deref() != Ok("1") => {
-            eprintln!("GPU test skipped: {e}");
-            None
-        }
-        Err(e) => panic!("GPU backend: {e}"),
-    }
-}
-
-/// Asserts the GPU's hits `got` against the CPU's `expected` (as `caster.rs` does): hit / miss
-/// identical on at least 99.99 % of the rays, distances within 1e-3 m, the same triangle except
-/// where the two are tied. Returns (hits, ties, disagreements).
-fn assert_agrees(
-    mesh: &SceneMesh,
-    rays: &[Ray],
-    expected: &[Option<Hit>],
-    got: &[Option<Hit>],
-) -> (usize, usize, usize) {
-    let (mut disagree, mut hits, mut ties) = (0usize, 0usize, 0usize);
-    for (i, (x, y)) in expected.iter().zip(got).enumerate() {
-        match (x, y) {
-            (Some(x), Some(y)) => {
-                hits += 1;
-                assert!((x.t - y.t).abs() <= 1e-3, "ray {i}: t {} (cpu) vs {} (gpu)", x.t, y.t);
-                if x.triangle != y.triangle {
-                    let ty = intersect_triangle(&rays[i], mesh.triangle(y.triangle as usize));
-                    assert!(
-                        ty.is_some_and(|t| (t - x.t).abs() <= 1e-3),
-                        "ray {i}: gpu triangle {} not tied",
-                        y.triangle
-                    );
-                    ties += 1;
-                }
-            }
-            (None, None) => {}
-            _ => disagree += 1,
-        }
-    }
-    let n = rays.len();
-    assert_eq!(got.len(), n);
-    assert!(hits > n / 3, "{hits} hits of {n}");
-    assert!(disagree as f64 <= 1e-4 * n as f64, "{disagree} of {n} rays disagree on hit / miss");
-    (hits, ties, disagree)
+    common::gpu_caster(mesh, GpuOptions { bvh, max_binding_bytes, ..GpuOptions::default() })
 }
 
 /// The CWBVH (and the BVH2) against the CPU's BVH on random rays and a spinning sensor's, single
@@ -142,7 +29,7 @@ fn cwbvh_matches_bvh() {
     let mesh = random_scene(7);
     let Some(gpu) = gpu_caster(&mesh, GpuBvh::Cwbvh, None) else { return };
     eprintln!("adapter: {}, scene {:?} B", gpu.adapter(), gpu.scene_bytes());
-    let rays = test_rays();
+    let rays = gpu_test_rays();
     let expected = BvhCaster::new(&mesh).cast_all(&rays);
     let got = gpu.cast_all(&rays);
     let (hits, ties, disagree) = assert_agrees(&mesh, &rays, &expected, &got);
@@ -233,13 +120,13 @@ fn cwbvh_splits_scene_over_two_node_bindings() {
     // A power of two of 80-byte nodes per binding that holds half of them or more.
     let node_limit = 80 * (node_bytes / 80).div_ceil(2).next_power_of_two();
     let tri_limit = 48 * (tri_bytes / 48).div_ceil(3).next_power_of_two();
-    let rays = test_rays();
+    let rays = gpu_test_rays();
     let want = whole.cast_all(&rays);
     let expected = BvhCaster::new(&mesh).cast_all(&rays);
     assert_agrees(&mesh, &rays, &expected, &want);
     for max_binding_bytes in [None, Some(tri_limit)] {
         let options = GpuOptions { bvh: GpuBvh::Cwbvh, max_binding_bytes, max_node_binding_bytes: Some(node_limit) };
-        let split = options_caster(&mesh, options).expect("an adapter");
+        let split = common::gpu_caster(&mesh, options).expect("an adapter");
         let (nodes, tris) = split.bindings_used();
         eprintln!(
             "limits {node_limit} / {max_binding_bytes:?} B: {node_bytes} + {tri_bytes} B in {nodes} + {tris} bindings"
@@ -255,37 +142,12 @@ fn cwbvh_splits_scene_over_two_node_bindings() {
 }
 
 /// A spinning sensor's beams cast from poses, the rays made on the device, on the CWBVH: the same
-/// hits as the CPU casting the rays the host makes ([`BeamSet::rays`]).
+/// hits as the CPU casting the rays the host makes ([`sim::cast::BeamSet::rays`]).
 #[test]
 fn cwbvh_casts_beams_made_on_the_device() {
     let mesh = random_scene(7);
     let Some(gpu) = gpu_caster(&mesh, GpuBvh::Cwbvh, None) else { return };
-    let (rings, cols, frames) = (32usize, 1024usize, 3usize);
-    let mut beams = Vec::new();
-    for ring in 0..rings {
-        let elevation = (-25.0f32 + ring as f32 * 1.2).to_radians();
-        for col in 0..cols {
-            let azimuth = col as f32 * std::f32::consts::TAU / cols as f32;
-            let dir = Vec3::new(elevation.cos() * azimuth.cos(), elevation.cos() * azimuth.sin(), elevation.sin());
-            beams.push(Beam {
-                origin_in_sensor: Vec3::new(0.05, 0.0, 0.0),
-                dir_in_sensor: dir,
-                t_max_m: 120.0,
-                pose: (col / 8) as u32,
-                pose_blend: (col % 8) as f32 / 8.0,
-                side_offset: 0.0,
-            });
-        }
-    }
-    let keys = cols / 8 + 1;
-    let set = BeamSet::new(beams, keys).unwrap();
-    let poses: Vec<Affine3A> = (0..frames * keys)
-        .map(|i| {
-            let s = (i / keys) as f32 + (i % keys) as f32 / (keys - 1) as f32;
-            Affine3A::from_translation(Vec3::new(0.3 + 1.5 * s, -0.2 + 0.1 * s, 4.0))
-                * Affine3A::from_rotation_z(0.05 * s)
-        })
-        .collect();
+    let (set, poses) = spinning_beams(3);
     let rays = set.rays(&poses);
     let expected = BvhCaster::new(&mesh).cast_all(&rays);
     let got = gpu.cast_beams(&set, &poses);

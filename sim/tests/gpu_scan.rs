@@ -4,26 +4,17 @@
 //! instead of a panic or a silent fallback to the CPU.
 #![cfg(feature = "gpu")]
 
-use sim::cast::gpu::{GpuCaster, GpuError};
+mod common;
+
+use common::gpu_caster;
+use sim::cast::gpu::GpuOptions;
 use sim::cast::{Backend, Caster};
 use sim::scan::{Agreement, AgreementContract, ScanConfig, Scanner};
-
-/// Whether there is an adapter (a skip message when not; a failure under `GROUNDTRUTH_REQUIRE_GPU=1`).
-fn gpu_or_skip(mesh: &sim::scene::SceneMesh) -> Option<GpuCaster> {
-    match GpuCaster::new(mesh) {
-        Ok(g) => Some(g),
-        Err(e @ GpuError::NoAdapter(_)) if std::env::var("GROUNDTRUTH_REQUIRE_GPU").as_deref() != Ok("1") => {
-            eprintln!("GPU test skipped: {e}");
-            None
-        }
-        Err(e) => panic!("GPU backend: {e}"),
-    }
-}
 
 #[test]
 fn pipelined_moving_frames_keep_the_contract() {
     let mesh = sim::scene::builtin::builtin("flat-objects").unwrap();
-    if gpu_or_skip(&mesh).is_none() {
+    if gpu_caster(&mesh, GpuOptions::default()).is_none() {
         return;
     }
     for (name, yaw) in [("lux-roof-4", 0.2), ("vlp16-roof", -0.3), ("os1-64-roof", 0.0)] {
@@ -55,7 +46,7 @@ fn pipelined_moving_frames_keep_the_contract() {
 #[test]
 fn a_lost_device_is_reported_not_replaced_by_the_cpu() {
     let mesh = sim::scene::builtin::builtin("flat-objects").unwrap();
-    let Some(gpu) = gpu_or_skip(&mesh) else { return };
+    let Some(gpu) = gpu_caster(&mesh, GpuOptions::default()) else { return };
     let ray = sim::cast::Ray { origin: glam::Vec3::new(0.0, 0.0, 2.0), dir: -glam::Vec3::Z, t_max: 100.0 };
     let before = gpu.cast_all(&[ray; 64]);
     assert!(before.iter().all(|h| h.is_some_and(|h| (h.t - 2.0).abs() < 0.05)), "{:?}", before[0]);

@@ -141,17 +141,22 @@ impl BeamSet {
         Ray { origin: world_from_sensor.transform_point3(beam.origin_in_sensor), dir, t_max: beam.t_max_m }
     }
 
+    /// Ray `r` of a call with `poses`: beam `r % beams` of frame `r / beams`.
+    pub fn call_ray(&self, r: usize, poses: &[Affine3A]) -> Ray {
+        let (n, per) = (self.beams.len(), self.poses_per_frame);
+        let frame = r / n;
+        self.ray(r % n, &poses[frame * per..(frame + 1) * per])
+    }
+
     /// The world rays of every frame in `poses`, frame after frame, each in beam order (made on
     /// the calling thread's rayon pool).
     pub fn rays(&self, poses: &[Affine3A]) -> Vec<Ray> {
         use rayon::prelude::*;
-        let n = self.beams.len();
-        let mut out = vec![Ray { origin: Vec3::ZERO, dir: Vec3::X, t_max: 0.0 }; n * self.frames_in(poses)];
+        let mut out =
+            vec![Ray { origin: Vec3::ZERO, dir: Vec3::X, t_max: 0.0 }; self.beams.len() * self.frames_in(poses)];
         out.par_chunks_mut(super::CHUNK).enumerate().for_each(|(k, chunk)| {
             for (j, ray) in chunk.iter_mut().enumerate() {
-                let r = k * super::CHUNK + j;
-                let (frame, b) = (r / n, r % n);
-                *ray = self.ray(b, &poses[frame * self.poses_per_frame..(frame + 1) * self.poses_per_frame]);
+                *ray = self.call_ray(k * super::CHUNK + j, poses);
             }
         });
         out

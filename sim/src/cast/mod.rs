@@ -71,6 +71,10 @@ impl Backend {
             #[cfg(feature = "gpu")]
             Backend::Gpu => match gpu::GpuCaster::new(mesh) {
                 Ok(c) => Ok(Box::new(c)),
+                // A bad layout variable is named as the field at fault.
+                Err(gpu::GpuError::Env { variable, value, allowed }) => {
+                    Err(crate::error::SimError::invalid(variable, value, allowed))
+                }
                 Err(e) => Err(crate::error::SimError::invalid("backend", "gpu", e.to_string())),
             },
             #[cfg(not(feature = "gpu"))]

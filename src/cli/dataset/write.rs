@@ -331,10 +331,14 @@ fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bo
         write_bytes_atomic(&seq.join("labels").join(format!("{stem}.label")), &label_bytes)?;
         Ok(n as u64)
     };
+    // A scanned frame checked against device faults and given the sequence's variations.
+    let finish_frame = |frame: &mut sim::scan::Frame| -> anyhow::Result<()> {
+        crate::cli::common::check_device(scanner.caster())?;
+        vary(&mut frame.cloud, s, frame.index)
+    };
     let scan_frame = |k: usize| -> anyhow::Result<sim::scan::Frame> {
         let mut frame = scanner.frame(k);
-        crate::cli::common::check_device(scanner.caster())?;
-        vary(&mut frame.cloud, s, k)?;
+        finish_frame(&mut frame)?;
         Ok(frame)
     };
     let mine: Vec<usize> = (0..frames).filter(|&k| shard.contains(first + k as u64)).collect();
@@ -356,8 +360,7 @@ fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bo
             let (pending, max_pending) = (std::sync::atomic::AtomicUsize::new(0), 2 * rayon::current_num_threads());
             let cast = rayon::scope(|scope| {
                 scanner.scan_frames(todo.iter().copied(), |mut frame| -> anyhow::Result<()> {
-                    crate::cli::common::check_device(scanner.caster())?;
-                    vary(&mut frame.cloud, s, frame.index)?;
+                    finish_frame(&mut frame)?;
                     let (written, write_frame, pending) = (&written, &write_frame, &pending);
                     let write = move |frame: sim::scan::Frame| {
                         let result = write_frame(frame.index, &frame);

@@ -1,30 +1,14 @@
 // Closest hit against a binary BVH (obvhs Bvh2 node layout, flattened on the CPU), traversed with a
 // fixed-size stack, nearer child first. The triangles, their bindings and the watertight test are
-// in `triangles.wgsl` (compiled before this file); the kernels of `cast.wgsl` (after it) call
-// `trace`.
+// in `triangles.wgsl` and the node bindings in `nodes.wgsl` (compiled before this file); the
+// kernels of `cast.wgsl` (after it) call `trace`.
 //
 // nodes: 2 vec4 per node: (min.xyz, prim_count bits), (max.xyz, first_index bits); an inner node
 //        (prim_count 0) has its children at first_index and first_index + 1, a leaf its triangles
-//        at first_index .. first_index + prim_count. Node n lives in binding nodes{n >> NODE_SHIFT}
-//        at (n & node mask), so a BVH larger than one storage binding spans two.
+//        at first_index .. first_index + prim_count. `node(n, h)` of
+//        `nodes.wgsl` (NODE_VEC4S = 2) is half h (0: min and prim_count, 1: max and first_index).
 // trace: (t bits, leaf-order triangle), triangle MISS: nothing hit, OVERFLOW: the stack
 //        overflowed (the host casts that ray on the CPU).
-@group(0) @binding(0) var<storage, read> nodes0: array<vec4<f32>>;
-@group(0) @binding(1) var<storage, read> nodes1: array<vec4<f32>>;
-
-// Nodes per binding as a power of two (a pipeline constant set per scene: the branch below folds
-// away when the scene fits one binding).
-override NODE_SHIFT: u32 = 31u;
-
-// Half `h` (0: min and prim_count, 1: max and first_index) of node `n`.
-fn node(n: u32, h: u32) -> vec4<f32> {
-    let j = 2u * (n & ((1u << NODE_SHIFT) - 1u)) + h;
-    if ((n >> NODE_SHIFT) == 0u) {
-        return nodes0[j];
-    }
-    return nodes1[j];
-}
-
 const STACK: u32 = 64u;
 
 // Entry distance (>= 0) of the ray into a node's box within t_best, or -1 when it misses.

@@ -2,7 +2,7 @@
 // incoherent ray traversal on GPUs through compressed wide BVHs"; obvhs `CwBvhNode` layout,
 // converted from the BVH2 on the CPU), traversed with a stack of node groups, children in the
 // order of the ray's octant. The triangles, their bindings and the watertight test are in
-// `triangles.wgsl` (compiled before this file); the kernels of `cast.wgsl` (after it) call `trace`.
+// `triangles.wgsl` and the node bindings in `nodes.wgsl` (compiled before this file); the kernels of `cast.wgsl` (after it) call `trace`.
 //
 // nodes: 5 vec4 (80 bytes) per node, read as u32 where not floats:
 //        0: (p.xyz: the node box's min corner, e bits: exponents ex | ey << 8 | ez << 16 and imask << 24)
@@ -16,8 +16,7 @@
 //        child 0b001_11sss (24 + its slot s), its node at child_base + the inner children in
 //        slots below s; a leaf 0bccc_ooooo, its triangles at prim_base + o (o < 24), as many as
 //        the unary c (001: 1, 011: 2, 111: 3).
-//        Node n lives in binding nodes{n >> NODE_SHIFT} at (n & node mask), so a BVH larger
-//        than one storage binding spans two.
+//        `node(n, h)` of `nodes.wgsl` (NODE_VEC4S = 5) is vec4 h of node n.
 // Hit masks (32 bits) of a node: bits 24..31 the inner children hit, at bit 24 + (slot ^ oct_inv)
 // where oct_inv is the octant of -d (the builder put the nearest child for octant o in slot o,
 // so the highest bit is the nearest child); bits 0..23 the triangles of the leaves hit, at their
@@ -25,22 +24,6 @@
 // A group (u32 pair): (child_base, inner hit bits | imask) or (prim_base, triangle bits).
 // trace: (t bits, leaf-order triangle), triangle MISS: nothing hit, OVERFLOW: the stack
 //        overflowed (the host casts that ray on the CPU).
-@group(0) @binding(0) var<storage, read> nodes0: array<vec4<f32>>;
-@group(0) @binding(1) var<storage, read> nodes1: array<vec4<f32>>;
-
-// Nodes per binding as a power of two (a pipeline constant set per scene: the branch below folds
-// away when the scene fits one binding).
-override NODE_SHIFT: u32 = 31u;
-
-// Part `h` (0 to 4, see above) of node `n`.
-fn node(n: u32, h: u32) -> vec4<f32> {
-    let j = 5u * (n & ((1u << NODE_SHIFT) - 1u)) + h;
-    if ((n >> NODE_SHIFT) == 0u) {
-        return nodes0[j];
-    }
-    return nodes1[j];
-}
-
 // Groups on the stack at most (a group per level of the tree: the BVH8's depth).
 const STACK: u32 = 32u;
 

@@ -283,21 +283,17 @@ impl Caster for GpuCaster {
         if stream.cast_beams(&self.gpu, &self.scene, beams, poses, &mut raw).is_err() {
             drop(stream);
             // Made on this thread: callers may be casting threads that must not wait on a pool.
-            let (n, per) = (beams.beams().len(), beams.poses_per_frame());
-            let rays: Vec<Ray> = (0..n * beams.frames_in(poses))
-                .map(|r| beams.ray(r % n, &poses[r / n * per..(r / n + 1) * per]))
-                .collect();
+            let rays: Vec<Ray> =
+                (0..beams.beams().len() * beams.frames_in(poses)).map(|r| beams.call_ray(r, poses)).collect();
             return self.cast_all(&rays);
         }
-        let (n, per) = (beams.beams().len(), beams.poses_per_frame());
         raw.into_iter()
             .enumerate()
             .map(|(r, (t_bits, prim))| match prim {
                 stream::MISS => None,
                 stream::OVERFLOW => {
                     stream.stats.cpu_fallbacks += 1;
-                    let (frame, b) = (r / n, r % n);
-                    self.cpu.cast(&beams.ray(b, &poses[frame * per..(frame + 1) * per]))
+                    self.cpu.cast(&beams.call_ray(r, poses))
                 }
                 p => Some(Hit { t: f32::from_bits(t_bits), triangle: self.scene.order_to_triangle[p as usize] }),
             })

@@ -134,16 +134,27 @@ impl SceneBuffers {
         let constants = [
             ("NODE_SHIFT", f64::from(if node_bindings > 1 { node_shift } else { NO_SPLIT })),
             ("TRI_SHIFT", f64::from(if tri_bindings > 1 { tri_shift } else { NO_SPLIT })),
+            ("NODE_VEC4S", (node_words / 4) as f64),
         ];
-        // One module: the triangles, the traversal of the layout, the kernels.
+        // One module: the triangles, the nodes, the traversal of the layout, the kernels.
         let (label, source) = match bvh {
             GpuBvh::Bvh2 => (
-                "triangles.wgsl + bvh2.wgsl + cast.wgsl",
-                concat!(include_str!("triangles.wgsl"), include_str!("bvh2.wgsl"), include_str!("cast.wgsl")),
+                "triangles.wgsl + nodes.wgsl + bvh2.wgsl + cast.wgsl",
+                concat!(
+                    include_str!("triangles.wgsl"),
+                    include_str!("nodes.wgsl"),
+                    include_str!("bvh2.wgsl"),
+                    include_str!("cast.wgsl")
+                ),
             ),
             GpuBvh::Cwbvh => (
-                "triangles.wgsl + cwbvh.wgsl + cast.wgsl",
-                concat!(include_str!("triangles.wgsl"), include_str!("cwbvh.wgsl"), include_str!("cast.wgsl")),
+                "triangles.wgsl + nodes.wgsl + cwbvh.wgsl + cast.wgsl",
+                concat!(
+                    include_str!("triangles.wgsl"),
+                    include_str!("nodes.wgsl"),
+                    include_str!("cwbvh.wgsl"),
+                    include_str!("cast.wgsl")
+                ),
             ),
         };
         let shader = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
