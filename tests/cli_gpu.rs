@@ -26,22 +26,11 @@ fn gpu_or_skip(out: &Output) -> Option<()> {
 
 #[test]
 fn the_gpu_keeps_the_agreement_contract_on_every_scene_family() {
-    let scenes = [
-        "flat",
-        "flat-objects",
-        "ramp-up",
-        "ramp-down",
-        "garage",
-        "basin",
-        "highway",
-        "rural",
-        "city",
-        "forest-sparse",
-        "forest-moderate",
-        "forest-dense",
-        "hill",
-        "elevated",
-    ];
+    // Every scene a user can name: the simulator's built-ins and the bundled library.
+    let builtin = sim::scene::builtin::NAMES;
+    let scenes: Vec<&str> =
+        builtin.into_iter().chain(scenes::bundled_names().into_iter().filter(|n| !builtin.contains(n))).collect();
+    assert!(scenes.len() >= 14, "{scenes:?}");
     let rigs = ["vlp16-roof", "hdl64e-roof", "os1-64-roof", "os1-128-roof", "lux-roof-4"];
     for (k, scene) in scenes.iter().enumerate() {
         let rig = rigs[k % rigs.len()];

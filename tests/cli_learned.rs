@@ -1,8 +1,8 @@
-//! Integration tests of the learned method and of `eval --dataset` through the binary:
+//! Integration tests of the learned method and of `eval dataset` through the binary:
 //! - `train --method learned` on a small dataset file trains in seconds, deterministically (the
 //!   same model bytes twice, and at 1 and 2 threads), and the model beats a stated F1 on scene
-//!   seeds it never saw, scored by `eval --dataset` on a dataset `groundtruth dataset` wrote;
-//! - `eval --dataset`: the JSON document's structure and counts, `--out` pictures, `--ground`,
+//!   seeds it never saw, scored by `eval dataset` on a dataset `groundtruth dataset` wrote;
+//! - `eval dataset`: the JSON document's structure and counts, `--out` pictures, `--ground`,
 //!   the protocols, and every bad input refused naming the file or flag, with nothing written.
 
 use std::path::{Path, PathBuf};
@@ -87,14 +87,25 @@ fn a_small_model_trains_deterministically_and_beats_nitsch_on_unseen_seeds() {
     // Scored on scene seeds it never saw.
     let data = held_out_dataset(&dir);
     let scores = dir.join("scores.json");
-    ok(run(&["eval", "--dataset", s(&data), "--methods", "nitsch,learned", "--model", s(&a), "--json", s(&scores)]));
+    ok(run(&[
+        "eval",
+        "dataset",
+        "--input",
+        s(&data),
+        "--methods",
+        "nitsch,learned",
+        "--model",
+        s(&a),
+        "--json",
+        s(&scores),
+    ]));
     let doc = json(&scores);
     let f1 = |m: &str| doc["methods"][m]["pooled"]["f1"].as_f64().unwrap();
     // Measured: learned 0.99+ on these frames, nitsch 0.97-0.98.
     assert!(f1("learned") >= 0.985, "learned F1 {}", f1("learned"));
     assert!(f1("learned") > f1("nitsch"), "learned {} vs nitsch {}", f1("learned"), f1("nitsch"));
     // A model of another format is refused, naming the file.
-    let e = err(run(&["eval", "--dataset", s(&data), "--methods", "learned", "--model", s(&config)]));
+    let e = err(run(&["eval", "dataset", "--input", s(&data), "--methods", "learned", "--model", s(&config)]));
     assert!(e.contains("train.toml") && e.contains("invalid model JSON"), "{e}");
 }
 
@@ -105,7 +116,8 @@ fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
     let (scores, pictures) = (dir.join("scores.json"), dir.join("pictures"));
     let out = ok(run(&[
         "eval",
-        "--dataset",
+        "dataset",
+        "--input",
         s(&data),
         "--methods",
         "nitsch,ransac",
@@ -135,7 +147,7 @@ fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
     }
     // Roads only: fewer ground points.
     let roads = dir.join("roads.json");
-    ok(run(&["eval", "--dataset", s(&data), "--methods", "nitsch", "--ground", "40,60", "--json", s(&roads)]));
+    ok(run(&["eval", "dataset", "--input", s(&data), "--methods", "nitsch", "--ground", "40,60", "--json", s(&roads)]));
     let r = json(&roads);
     assert_eq!(r["protocol"]["name"], "semantickitti+ground");
     let ground = |d: &serde_json::Value| {
@@ -155,8 +167,14 @@ fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
         (vec!["--max-frames".into(), "0".into()], "--max-frames"),
     ];
     for (extra, needle) in cases {
-        let mut args =
-            vec!["eval".to_string(), "--dataset".into(), s(&data).into(), "--json".into(), s(&written).into()];
+        let mut args = vec![
+            "eval".to_string(),
+            "dataset".into(),
+            "--input".into(),
+            s(&data).into(),
+            "--json".into(),
+            s(&written).into(),
+        ];
         args.extend(extra);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let e = err(run(&args));
@@ -165,23 +183,23 @@ fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
     }
     // A folder that is no dataset; a sequence without labels; a label count that differs; an
     // empty sequence; a truncated cloud.
-    let e = err(run(&["eval", "--dataset", s(&dir.join("pictures"))]));
+    let e = err(run(&["eval", "dataset", "--input", s(&dir.join("pictures"))]));
     assert!(e.contains("not a SemanticKITTI-layout dataset"), "{e}");
     let bad = dir.join("bad/sequences/00");
     std::fs::create_dir_all(bad.join("velodyne")).unwrap();
     std::fs::write(bad.join("velodyne/000000.bin"), [0u8; 32]).unwrap();
-    let e = err(run(&["eval", "--dataset", s(&dir.join("bad"))]));
+    let e = err(run(&["eval", "dataset", "--input", s(&dir.join("bad"))]));
     assert!(e.contains("no `labels/`"), "{e}");
     std::fs::create_dir_all(bad.join("labels")).unwrap();
     std::fs::write(bad.join("labels/000000.label"), [0u8; 12]).unwrap();
-    let e = err(run(&["eval", "--dataset", s(&dir.join("bad")), "--json", s(&written)]));
+    let e = err(run(&["eval", "dataset", "--input", s(&dir.join("bad")), "--json", s(&written)]));
     assert!(e.contains("000000.label") && e.contains("3 labels") && e.contains("2 points"), "{e}");
     assert!(!written.exists());
     std::fs::write(bad.join("velodyne/000000.bin"), [0u8; 30]).unwrap();
-    let e = err(run(&["eval", "--dataset", s(&dir.join("bad"))]));
+    let e = err(run(&["eval", "dataset", "--input", s(&dir.join("bad"))]));
     assert!(e.contains("000000.bin") && e.contains("30 bytes"), "{e}");
     std::fs::remove_file(bad.join("velodyne/000000.bin")).unwrap();
-    let e = err(run(&["eval", "--dataset", s(&dir.join("bad"))]));
+    let e = err(run(&["eval", "dataset", "--input", s(&dir.join("bad"))]));
     assert!(e.contains("no `.bin` frames"), "{e}");
     // Training refuses another method's flags and a dataset without our manifest and --rig.
     let e = err(run(&["train", "--method", "learned", "--scene", "city", "--out", s(&written)]));
@@ -189,4 +207,46 @@ fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
     let e = err(run(&["train", "--method", "learned", "--dataset", s(&dir.join("bad")), "--out", s(&written)]));
     assert!(e.contains("--rig"), "{e}");
     assert!(!written.exists());
+}
+
+#[test]
+fn eval_takes_one_mode_and_refuses_flags_of_another_the_old_spellings_still_work() {
+    let dir = tmp("eval-modes");
+    let json_path = dir.join("never.json");
+    let j = s(&json_path);
+    // A flag of another mode is a usage error from the argument parser, before any work.
+    for (args, flag) in [
+        (
+            vec!["eval", "scene", "--scene", "flat", "--rig", "vlp16-roof", "--protocol", "patchwork", "--json", j],
+            "--protocol",
+        ),
+        (vec!["eval", "dataset", "--input", "x", "--frames", "2", "--json", j], "--frames"),
+        (vec!["eval", "paper", "mcdaniel", "--methods", "nitsch", "--json", j], "--methods"),
+        (vec!["eval", "paper", "forests", "--json", j], "forests"),
+        (vec!["eval", "scene", "--rig", "vlp16-roof", "--json", j], "--scene"),
+    ] {
+        let e = err(run(&args));
+        assert!(
+            e.contains(flag)
+                && (e.contains("unexpected argument") || e.contains("invalid value") || e.contains("required")),
+            "{args:?}: {e}"
+        );
+        assert!(!json_path.exists());
+    }
+    // `eval scene` scores, and the flat spelling of the previous release gives the same numbers
+    // with a deprecation message.
+    let (new, old) = (dir.join("new.json"), dir.join("old.json"));
+    let common = ["--rig", "vlp16-roof", "--frames", "1", "--methods", "nitsch,ransac"];
+    let mut a = vec!["eval", "scene", "--scene", "flat-objects", "--speed-m-per-s", "5", "--json", s(&new)];
+    a.extend(common);
+    ok(run(&a));
+    let mut b = vec!["eval", "--scene", "flat-objects", "--speed", "5", "--json", s(&old)];
+    b.extend(common);
+    let out = run(&b);
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("deprecated") && stderr.contains("eval scene"), "{stderr}");
+    assert_eq!(std::fs::read(&new).unwrap(), std::fs::read(&old).unwrap());
+    let f1 = json(&new)["methods"]["nitsch"]["f1"].as_f64().unwrap();
+    assert!(f1 > 0.9, "nitsch F1 {f1}");
 }

@@ -84,6 +84,15 @@ pub fn check_cloud(cloud: &sim::OrderedCloud) -> Result<()> {
     Ok(())
 }
 
+/// [`check_cloud`], and that `out` holds one decision per cell of `cloud` (all planes).
+pub fn check_cloud_and_output(cloud: &sim::OrderedCloud, out: &[bool]) -> Result<()> {
+    check_cloud(cloud)?;
+    if out.len() != cloud.len() {
+        return Err(ClassifyError::Inconsistent(format!("output has {} entries, cloud {}", out.len(), cloud.len())));
+    }
+    Ok(())
+}
+
 /// Whether cell `i` holds a usable return: a point with three finite coordinates. Cells whose range
 /// is finite but whose coordinates are NaN (corrupt input) are treated as no return.
 #[inline]

@@ -1,5 +1,5 @@
 """`eval_dataset`: our methods scored on a labelled SemanticKITTI-layout recording, the numbers of
-`groundtruth eval --dataset --json`, and its refusals of bad datasets and options."""
+`groundtruth eval dataset --input --json`, and its refusals of bad datasets and options."""
 
 import json
 import pathlib

@@ -1,12 +1,15 @@
-//! `groundtruth eval`: scans a scene with a rig, classifies every frame with each method and prints
-//! one row per method (`acc FPR precision recall F1 IoU`, pooled over all returns of all frames),
-//! like Table I of Nitsch et al. With `--json FILE` the same numbers are written atomically as
-//! `{"methods": {NAME: {"acc", "fpr", "precision", "recall", "f1", "iou"}}}`; `--details` also
-//! prints the per-frame means and the breakdown by class and range band.
+//! `groundtruth eval`, one mode per invocation:
 //!
-//! `--paper mcdaniel` runs McDaniel et al.'s own evaluation instead ([`super::eval_paper`]);
-//! `--dataset DIR` scores methods on a labelled recording in the SemanticKITTI layout
-//! ([`super::eval_dataset`]).
+//! - `eval scene --scene S --rig R`: scans a scene with a rig, classifies every frame with each
+//!   method and prints one row per method (`acc FPR precision recall F1 IoU`, pooled over all
+//!   returns of all frames), like Table I of Nitsch et al. With `--json FILE` the same numbers are
+//!   written atomically as `{"methods": {NAME: {"acc", "fpr", "precision", "recall", "f1", "iou"}}}`;
+//!   `--details` also prints the per-frame means and the breakdown by class and range band.
+//! - `eval dataset --input DIR`: scores methods on a labelled recording ([`super::eval_dataset`]).
+//! - `eval paper mcdaniel`: McDaniel et al.'s own evaluation ([`super::eval_paper`]).
+//!
+//! The flat spellings of the previous release (`eval --scene`, `eval --dataset DIR`, `eval --paper
+//! mcdaniel`) are still read, with a deprecation message on stderr.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -22,53 +25,42 @@ const TABLE_METHODS: &str = "nitsch,nitsch-0.7,nitsch-no-cluster,nitsch-no-clust
 /// `eval --dataset`'s default methods.
 const DATASET_METHODS: &str = "nitsch";
 
-/// Arguments of `groundtruth eval`.
+/// Arguments of `groundtruth eval`: one mode per invocation (`eval scene`, `eval dataset`,
+/// `eval paper`), so a flag of another mode is a usage error. The flat spellings of earlier
+/// releases (`eval --scene`, `eval --dataset DIR`, `eval --paper mcdaniel`) still work for one
+/// release, with a deprecation message.
 #[derive(clap::Args, Debug)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Args {
+    #[command(subcommand)]
+    mode: Option<Mode>,
+    #[command(flatten)]
+    legacy: LegacyArgs,
+}
+
+/// `eval`'s modes.
+#[derive(clap::Subcommand, Debug)]
+enum Mode {
+    /// Scan a scene with a rig and score methods on every return (Table I of Nitsch et al.).
+    Scene(SceneArgs),
+    /// Score methods on a labelled recording (SemanticKITTI layout, real or ours, or a bag).
+    Dataset(DatasetModeArgs),
+    /// A paper's own evaluation (`mcdaniel`: Tables I-III and the ROC figure of seed 002).
+    Paper(PaperModeArgs),
+}
+
+/// `groundtruth eval scene`.
+#[derive(clap::Args, Debug)]
+struct SceneArgs {
     /// Scene name or TOML file.
-    #[arg(long, required_unless_present_any = ["paper", "dataset"], conflicts_with = "dataset")]
-    scene: Option<String>,
-    /// Rig name or TOML file (with `--dataset`: the rig whose beam table and mount order the
-    /// frames, as `classify --rig`).
-    #[arg(long, required_unless_present_any = ["paper", "dataset"])]
-    rig: Option<String>,
-    /// Run a paper's own evaluation instead (`mcdaniel`: Tables I-III and the ROC figure of seed 002).
-    #[arg(long, conflicts_with_all = ["scene", "rig", "methods", "frames", "speed", "details", "dataset"])]
-    paper: Option<String>,
-    /// Score methods on a labelled recording in the SemanticKITTI layout
-    /// (`DIR/sequences/NN/{velodyne,labels}` or one sequence's folder), real or ours.
-    #[arg(long, conflicts_with_all = ["frames", "speed", "ideal"])]
-    dataset: Option<PathBuf>,
-    /// With `--dataset`: only these sequences (comma-separated folder names).
-    #[arg(long, requires = "dataset")]
-    sequences: Option<String>,
-    /// With `--dataset`: the sensor's own calibration file (as `classify --calibration`).
-    #[arg(long, requires = "dataset")]
-    calibration: Option<PathBuf>,
-    /// With `--dataset`: the protocol (`semantickitti`, `patchworkpp`, `patchwork`).
-    #[arg(long, default_value = "semantickitti", requires = "dataset")]
-    protocol: String,
-    /// With `--dataset`: ground class ids replacing the protocol's (comma-separated SemanticKITTI ids).
-    #[arg(long, requires = "dataset")]
-    ground: Option<String>,
-    /// With `--dataset --protocol patchwork`: the sensor's height above the ground, metres.
-    #[arg(long, default_value_t = 1.73, requires = "dataset")]
-    sensor_height: f32,
-    /// With `--dataset BAG` (an `.mcap` or rosbag2 directory): the PointCloud2 topic (its clouds
-    /// carry a `label` field).
-    #[arg(long, requires = "dataset")]
-    topic: Option<String>,
-    /// With `--dataset`: score at most this many frames per sequence.
-    #[arg(long, requires = "dataset")]
-    max_frames: Option<usize>,
-    /// Output directory: `--paper`'s figures (default `out/paper-mcdaniel`), `--dataset`'s outcome
-    /// pictures (none by default).
     #[arg(long)]
-    out: Option<PathBuf>,
-    /// Comma-separated method names (see `groundtruth list`; default: the Table I set, with
-    /// `--dataset` `nitsch`).
+    scene: String,
+    /// Rig name or TOML file.
     #[arg(long)]
-    methods: Option<String>,
+    rig: String,
+    /// Comma-separated method names (see `groundtruth list`; default: the Table I set).
+    #[arg(long, default_value = TABLE_METHODS)]
+    methods: String,
     /// Number of frames to scan.
     #[arg(long, default_value_t = 5)]
     frames: usize,
@@ -77,7 +69,7 @@ pub struct Args {
     seed: u64,
     /// Ego speed, metres per second.
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
-    speed: f32,
+    speed_m_per_s: f32,
     /// Turn measurement effects off.
     #[arg(long)]
     ideal: bool,
@@ -87,58 +79,241 @@ pub struct Args {
     /// Also print per-frame means and the breakdown by class and range band.
     #[arg(long)]
     details: bool,
-    /// Trained model file for `mcdaniel` (`groundtruth train`; default: the bundled forest model).
-    #[arg(long, conflicts_with = "paper")]
+    /// Trained model file for `mcdaniel` or `learned` (`groundtruth train`; default: the bundled
+    /// model).
+    #[arg(long)]
     model: Option<PathBuf>,
+}
+
+/// `groundtruth eval dataset`.
+#[derive(clap::Args, Debug)]
+struct DatasetModeArgs {
+    /// The labelled recording: `DIR/sequences/NN/{velodyne,labels}`, one sequence's folder, or a
+    /// bag (`.mcap` or rosbag2 directory) whose clouds carry a `label` field.
+    #[arg(long)]
+    input: PathBuf,
+    /// Comma-separated method names (see `groundtruth list`).
+    #[arg(long, default_value = DATASET_METHODS)]
+    methods: String,
+    /// Only these sequences (comma-separated folder names).
+    #[arg(long)]
+    sequences: Option<String>,
+    /// The rig whose beam table and mount order the frames (as `classify --rig`).
+    #[arg(long)]
+    rig: Option<String>,
+    /// The sensor's own calibration file (as `classify --calibration`).
+    #[arg(long)]
+    calibration: Option<PathBuf>,
+    /// The protocol (`semantickitti`, `patchworkpp`, `patchwork`).
+    #[arg(long, default_value = "semantickitti")]
+    protocol: String,
+    /// Ground class ids replacing the protocol's (comma-separated SemanticKITTI ids).
+    #[arg(long)]
+    ground: Option<String>,
+    /// With `--protocol patchwork`: the sensor's height above the ground, metres.
+    #[arg(long, default_value_t = 1.73)]
+    sensor_height_m: f32,
+    /// With a bag: the PointCloud2 topic.
+    #[arg(long)]
+    topic: Option<String>,
+    /// Score at most this many frames per sequence.
+    #[arg(long)]
+    max_frames: Option<usize>,
+    /// Draw each frame's outcome per method into this folder (none by default).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write every number (per frame too) to this JSON file.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Also print a line per frame.
+    #[arg(long)]
+    details: bool,
+    /// Trained model file for `mcdaniel` or `learned` (default: the bundled model).
+    #[arg(long)]
+    model: Option<PathBuf>,
+}
+
+/// The papers whose own evaluation `eval paper` runs.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum Paper {
+    /// McDaniel et al., forests: Tables I-III and the ROC figure.
+    Mcdaniel,
+}
+
+/// `groundtruth eval paper`.
+#[derive(clap::Args, Debug)]
+struct PaperModeArgs {
+    /// Which paper.
+    paper: Paper,
+    /// Seed of the scenes and the scan noise.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Turn measurement effects off.
+    #[arg(long)]
+    ideal: bool,
+    /// Where the figures go.
+    #[arg(long, default_value = "out/paper-mcdaniel")]
+    out: PathBuf,
+    /// Write every number to this JSON file.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+/// The flat spellings of earlier releases (`eval --scene`, `--dataset`, `--paper`), hidden from the
+/// help and turned into a mode with a deprecation message.
+#[derive(clap::Args, Debug)]
+struct LegacyArgs {
+    #[arg(long, hide = true, required_unless_present_any = ["paper", "dataset"], conflicts_with = "dataset")]
+    scene: Option<String>,
+    #[arg(long, hide = true, required_unless_present_any = ["paper", "dataset"])]
+    rig: Option<String>,
+    #[arg(long, hide = true, conflicts_with_all = ["scene", "rig", "methods", "frames", "speed", "details", "dataset"])]
+    paper: Option<String>,
+    #[arg(long, hide = true, conflicts_with_all = ["frames", "speed", "ideal"])]
+    dataset: Option<PathBuf>,
+    #[arg(long, hide = true, requires = "dataset")]
+    sequences: Option<String>,
+    #[arg(long, hide = true, requires = "dataset")]
+    calibration: Option<PathBuf>,
+    #[arg(long, hide = true, default_value = "semantickitti", requires = "dataset")]
+    protocol: String,
+    #[arg(long, hide = true, requires = "dataset")]
+    ground: Option<String>,
+    #[arg(long, hide = true, default_value_t = 1.73, requires = "dataset")]
+    sensor_height: f32,
+    #[arg(long, hide = true, requires = "dataset")]
+    topic: Option<String>,
+    #[arg(long, hide = true, requires = "dataset")]
+    max_frames: Option<usize>,
+    #[arg(long, hide = true)]
+    out: Option<PathBuf>,
+    #[arg(long, hide = true)]
+    methods: Option<String>,
+    #[arg(long, hide = true, default_value_t = 5)]
+    frames: usize,
+    #[arg(long, hide = true, default_value_t = 0)]
+    seed: u64,
+    #[arg(long, hide = true, default_value_t = 10.0, allow_negative_numbers = true)]
+    speed: f32,
+    #[arg(long, hide = true)]
+    ideal: bool,
+    #[arg(long, hide = true)]
+    json: Option<PathBuf>,
+    #[arg(long, hide = true)]
+    details: bool,
+    #[arg(long, hide = true, conflicts_with = "paper")]
+    model: Option<PathBuf>,
+}
+
+impl LegacyArgs {
+    /// The mode the flat spelling asks for, with the deprecation message printed; the checks of the
+    /// earlier release (flags that apply to another mode) are kept.
+    fn into_mode(self) -> anyhow::Result<Mode> {
+        let deprecated = |old: &str, new: &str| {
+            eprintln!(
+                "warning: `groundtruth eval {old}` is deprecated and will be removed in the next release; use `groundtruth eval {new}`"
+            );
+        };
+        if let Some(paper) = self.paper {
+            deprecated("--paper NAME", "paper NAME");
+            let paper = match paper.as_str() {
+                "mcdaniel" => Paper::Mcdaniel,
+                other => anyhow::bail!("--paper `{other}`: known papers: mcdaniel"),
+            };
+            let out = self.out.unwrap_or_else(|| PathBuf::from("out/paper-mcdaniel"));
+            return Ok(Mode::Paper(PaperModeArgs { paper, seed: self.seed, ideal: self.ideal, out, json: self.json }));
+        }
+        if let Some(input) = self.dataset {
+            deprecated("--dataset DIR", "dataset --input DIR");
+            return Ok(Mode::Dataset(DatasetModeArgs {
+                input,
+                methods: self.methods.unwrap_or_else(|| DATASET_METHODS.to_string()),
+                sequences: self.sequences,
+                rig: self.rig,
+                calibration: self.calibration,
+                protocol: self.protocol,
+                ground: self.ground,
+                sensor_height_m: self.sensor_height,
+                topic: self.topic,
+                max_frames: self.max_frames,
+                out: self.out,
+                json: self.json,
+                details: self.details,
+                model: self.model,
+            }));
+        }
+        deprecated("--scene S --rig R", "scene --scene S --rig R");
+        if self.out.is_some() {
+            anyhow::bail!("--out applies to --paper and --dataset");
+        }
+        let (Some(scene), Some(rig)) = (self.scene, self.rig) else {
+            anyhow::bail!("--scene and --rig are required (or --paper mcdaniel)");
+        };
+        Ok(Mode::Scene(SceneArgs {
+            scene,
+            rig,
+            methods: self.methods.unwrap_or_else(|| TABLE_METHODS.to_string()),
+            frames: self.frames,
+            seed: self.seed,
+            speed_m_per_s: self.speed,
+            ideal: self.ideal,
+            json: self.json,
+            details: self.details,
+            model: self.model,
+        }))
+    }
 }
 
 /// Runs `groundtruth eval`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    if let Some(paper) = &args.paper {
-        if paper != "mcdaniel" {
-            anyhow::bail!("--paper `{paper}`: known papers: mcdaniel");
-        }
-        let paper_args = super::eval_paper::PaperArgs {
-            seed: args.seed,
-            ideal: args.ideal,
-            out: args.out.clone().unwrap_or_else(|| PathBuf::from("out/paper-mcdaniel")),
-            json: args.json.clone(),
-        };
-        return super::eval_paper::run(&paper_args);
-    }
-    if let Some(dir) = &args.dataset {
-        let methods = super::common::split_list(args.methods.as_deref().unwrap_or(DATASET_METHODS));
-        return super::eval_dataset::run(&super::eval_dataset::DatasetArgs {
-            dir,
-            sequences: args.sequences.as_deref().map(super::common::split_list),
-            methods,
-            rig: args.rig.as_deref(),
-            calibration: args.calibration.as_deref(),
-            protocol: &args.protocol,
-            ground: args.ground.as_deref(),
-            sensor_height_m: args.sensor_height,
-            max_frames: args.max_frames,
-            json: args.json.as_deref(),
-            out: args.out.as_deref(),
-            model: args.model.as_deref(),
-            details: args.details,
-            topic: args.topic.as_deref(),
-        });
-    }
-    if args.out.is_some() {
-        anyhow::bail!("--out applies to --paper and --dataset");
-    }
-    let (Some(scene_name), Some(rig_name)) = (&args.scene, &args.rig) else {
-        anyhow::bail!("--scene and --rig are required (or --paper mcdaniel)");
+    let mode = match args.mode {
+        Some(mode) => mode,
+        None => args.legacy.into_mode()?,
     };
-    let names = super::common::split_list(args.methods.as_deref().unwrap_or(TABLE_METHODS));
+    match mode {
+        Mode::Scene(a) => run_scene(&a),
+        Mode::Dataset(a) => super::eval_dataset::run(&super::eval_dataset::DatasetArgs {
+            dir: &a.input,
+            sequences: a.sequences.as_deref().map(super::common::split_list),
+            methods: super::common::split_list(&a.methods),
+            rig: a.rig.as_deref(),
+            calibration: a.calibration.as_deref(),
+            protocol: &a.protocol,
+            ground: a.ground.as_deref(),
+            sensor_height_m: a.sensor_height_m,
+            max_frames: a.max_frames,
+            json: a.json.as_deref(),
+            out: a.out.as_deref(),
+            model: a.model.as_deref(),
+            details: a.details,
+            topic: a.topic.as_deref(),
+        }),
+        Mode::Paper(a) => {
+            let Paper::Mcdaniel = a.paper;
+            super::eval_paper::run(&super::eval_paper::PaperArgs {
+                seed: a.seed,
+                ideal: a.ideal,
+                out: a.out,
+                json: a.json,
+            })
+        }
+    }
+}
+
+/// Runs `groundtruth eval scene`.
+fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
+    let (scene_name, rig_name) = (&args.scene, &args.rig);
+    let names = super::common::split_list(&args.methods);
     if names.is_empty() {
         anyhow::bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));
     }
     if let Some(model) = &args.model
         && !names.iter().any(|n| super::common::takes_model(n))
     {
-        anyhow::bail!("--model `{}` applies to `mcdaniel`, which --methods does not name", model.display());
+        anyhow::bail!(
+            "--model `{}` applies to `mcdaniel` and `learned`, which --methods does not name",
+            model.display()
+        );
     }
     // Refuse unknown names before scanning.
     for n in &names {
@@ -149,7 +324,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let config = ScanConfig {
         seed: args.seed,
         frames: args.frames,
-        speed_m_per_s: args.speed,
+        speed_m_per_s: args.speed_m_per_s,
         ideal: args.ideal,
         ego_z_m: scene.ego_ground_z_m,
         ..Default::default()

@@ -48,7 +48,7 @@ enum Command {
     Render(render::Args),
     /// Classify ground points in scanned clouds.
     Classify(classify::Args),
-    /// Score methods: on a scanned scene (Table I style), on a labelled recording (`--dataset DIR`), or a paper's evaluation (`--paper mcdaniel`).
+    /// Score methods: `eval scene` (a scanned scene, Table I style), `eval dataset` (a labelled recording) or `eval paper mcdaniel`.
     Eval(eval::Args),
     /// Train a learning method (McDaniel et al.'s SVM, or the learned method's trees) on our scans and write the model (JSON).
     Train(train::Args),

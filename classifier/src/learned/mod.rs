@@ -29,7 +29,7 @@ pub use features::{FEATURE_COUNT, FEATURE_NAMES, FeatureColumns};
 pub use forest::{Forest, LANES};
 pub use model::{LearnedModel, LearnedModelError, ObliviousTree};
 
-use crate::error::{ClassifyError, Result, check_cloud};
+use crate::error::{ClassifyError, Result, check_cloud_and_output};
 use crate::nitsch::{Nitsch, NitschParams, echoes_from_plane0};
 
 /// The bundled model's JSON.
@@ -80,14 +80,7 @@ impl Extractor {
     /// Runs Nitsch's method on `cloud`, writing its decisions to `out` (every cell, all planes),
     /// and computes the features of plane 0 ([`Extractor::features`]).
     pub fn compute(&mut self, cloud: &sim::OrderedCloud, out: &mut [bool]) -> Result<()> {
-        check_cloud(cloud)?;
-        if out.len() != cloud.len() {
-            return Err(ClassifyError::Inconsistent(format!(
-                "output has {} entries, cloud {}",
-                out.len(),
-                cloud.len()
-            )));
-        }
+        check_cloud_and_output(cloud, out)?;
         self.nitsch.classify_into(cloud, out)?;
         let n = cloud.rows * cloud.cols;
         self.nitsch_ground.clear();

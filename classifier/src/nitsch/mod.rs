@@ -15,7 +15,7 @@ mod row_returns;
 
 use glam::Vec3;
 
-use crate::error::{ClassifyError, Result, check_cloud, is_valid};
+use crate::error::{ClassifyError, Result, check_cloud_and_output, is_valid};
 use crate::nitsch::cluster::{ClusterParams, ClusterWorkspace, cluster_candidates_searched};
 use crate::nitsch::features::{FeatureParams, Features, compute_features};
 use crate::nitsch::neighbours::{GridView, NeighbourParams, Wrap, detect_wrap};
@@ -133,14 +133,7 @@ impl Nitsch {
 
     /// As [`Nitsch::classify`], writing into `out` (length `cloud.len()`).
     pub fn classify_into(&mut self, cloud: &sim::OrderedCloud, out: &mut [bool]) -> Result<()> {
-        check_cloud(cloud)?;
-        if out.len() != cloud.len() {
-            return Err(ClassifyError::Inconsistent(format!(
-                "output has {} entries, cloud {}",
-                out.len(),
-                cloud.len()
-            )));
-        }
+        check_cloud_and_output(cloud, out)?;
         let t0 = std::time::Instant::now();
         let reversed = if self.params.fix_row_order { row_order::reversed_columns(cloud) } else { None };
         let n = cloud.rows * cloud.cols;

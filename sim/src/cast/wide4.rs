@@ -154,19 +154,7 @@ impl Wide4 {
             let n = &self.nodes[node as usize];
             let (t_near, hit) = slab4(n, &rb, best_t);
             // Children met, nearest first.
-            let mut order = [(0usize, 0.0f32); 4];
-            let mut m = 0;
-            for k in 0..4 {
-                if hit[k] {
-                    let mut i = m;
-                    while i > 0 && order[i - 1].1 > t_near[k] {
-                        order[i] = order[i - 1];
-                        i -= 1;
-                    }
-                    order[i] = (k, t_near[k]);
-                    m += 1;
-                }
-            }
+            let (order, m) = nearest_first(&t_near, &hit);
             // Leaves at once (they shorten `best_t` for their siblings), inner children after.
             let mut inner = [(0u32, 0.0f32); 4];
             let mut q = 0;
@@ -315,19 +303,7 @@ impl Wide4 {
         loop {
             let n = &self.nodes[node as usize];
             let (t_near, hit) = slab4_fan::<ONE_ORIGIN>(n, &fan, &near, &far, far_t);
-            let mut order = [(0usize, 0.0f32); 4];
-            let mut m = 0;
-            for k in 0..4 {
-                if hit[k] {
-                    let mut i = m;
-                    while i > 0 && order[i - 1].1 > t_near[k] {
-                        order[i] = order[i - 1];
-                        i -= 1;
-                    }
-                    order[i] = (k, t_near[k]);
-                    m += 1;
-                }
-            }
+            let (order, m) = nearest_first(&t_near, &hit);
             let mut inner = [(0u32, 0.0f32); 4];
             let mut q = 0;
             let mut leaf_hits: Option<[[bool; 4]; N]> = None;
@@ -403,6 +379,26 @@ fn slab4_fan<const ONE_ORIGIN: bool>(
         hit[k] = t_near[k] <= t_far[k] && n.count[k] != EMPTY;
     }
     (t_near, hit)
+}
+
+/// The children a ray meets (`hit`), as `(child, entry distance)` nearest first (an insertion sort:
+/// equal distances keep the child order), and how many there are.
+#[inline(always)]
+fn nearest_first(t_near: &[f32; 4], hit: &[bool; 4]) -> ([(usize, f32); 4], usize) {
+    let mut order = [(0usize, 0.0f32); 4];
+    let mut m = 0;
+    for k in 0..4 {
+        if hit[k] {
+            let mut i = m;
+            while i > 0 && order[i - 1].1 > t_near[k] {
+                order[i] = order[i - 1];
+                i -= 1;
+            }
+            order[i] = (k, t_near[k]);
+            m += 1;
+        }
+    }
+    (order, m)
 }
 
 /// The next node to visit: the nearest of `inner` (children met, nearest first) whose entry distance
