@@ -37,7 +37,7 @@ fn assert_uniform(elevations: &[f64], spacing_deg: f64) {
 
 #[test]
 fn every_preset_validates() {
-    let expected_sensors = [1usize, 4, 7, 1, 1, 1, 1, 1, 1];
+    let expected_sensors = [1usize, 4, 7, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1];
     assert_eq!(PRESETS.len(), expected_sensors.len());
     for (name, n) in PRESETS.iter().zip(expected_sensors) {
         let rig = Rig::preset(name).unwrap();

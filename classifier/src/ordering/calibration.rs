@@ -24,6 +24,12 @@
 //!   the top level or under `beam_intrinsics`), columns from `lidar_mode` (`"1024x10"`; at the top
 //!   level or under `config_params`). Ouster's radial `lidar_origin_to_beam_origin_mm` moves a point
 //!   along its beam, not across rows or columns, and is not needed to order a cloud.
+//! - `.csv`: Hesai's angle-correction file: a header `Laser id,Elevation,Azimuth` (or
+//!   `Channel,Elevation,Azimuth`), then one line per laser, ids 1 ..= N each once, angles in
+//!   degrees. Hesai's azimuth is positive clockwise (seen from above), so a laser's
+//!   `azimuth_offset_deg` (left positive) is minus the file's `Azimuth`. Refused, naming the file,
+//!   the line and the field: a missing or repeated laser id, a NaN or infinite angle, a line
+//!   without three values.
 //!
 //! Refused, naming the file: no lasers or more than 65535, a laser count other than the expected
 //! one (a rig's or an organized cloud's rows), non-finite or out-of-range angles (elevations within
@@ -88,8 +94,12 @@ impl Calibration {
             "txt" => parse_text(path, text)?,
             "yaml" | "yml" => parse_velodyne_yaml(path, text)?,
             "json" => parse_ouster_json(path, text)?,
+            "csv" => parse_hesai_csv(path, text)?,
             other => {
-                return Err(err(path, format!("unknown extension `{other}` (allowed: toml, txt, yaml, yml, json)")));
+                return Err(err(
+                    path,
+                    format!("unknown extension `{other}` (allowed: toml, txt, yaml, yml, json, csv)"),
+                ));
             }
         };
         cal.check(path, expected_lasers)?;
@@ -256,6 +266,92 @@ fn parse_ouster_json(path: &Path, text: &str) -> Result<Calibration, Calibration
             .iter()
             .zip(&az)
             .map(|(&e, &a)| LaserCalibration { elevation_deg: e, azimuth_offset_deg: a, ..Default::default() })
+            .collect(),
+    })
+}
+
+/// Hesai's angle-correction CSV (module docs): `Laser id,Elevation,Azimuth` lines after a header.
+fn parse_hesai_csv(path: &Path, text: &str) -> Result<Calibration, CalibrationError> {
+    // (line number, laser id, elevation, azimuth) in file order.
+    let mut rows: Vec<(usize, u32, f64, f64)> = Vec::new();
+    let mut id_field = "Laser id";
+    let mut header_seen = false;
+    for (k, line) in text.lines().enumerate() {
+        let line_no = k + 1;
+        let line = line.trim().trim_start_matches('\u{feff}');
+        if line.is_empty() {
+            continue;
+        }
+        let mut cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        if cells.len() == 4 && cells[3].is_empty() {
+            cells.pop(); // a trailing comma
+        }
+        if !header_seen && rows.is_empty() {
+            let names: Vec<String> = cells.iter().map(|c| c.to_ascii_lowercase()).collect();
+            if names.len() == 3
+                && (names[0] == "laser id" || names[0] == "channel")
+                && names[1] == "elevation"
+                && names[2] == "azimuth"
+            {
+                header_seen = true;
+                id_field = if names[0] == "channel" { "Channel" } else { "Laser id" };
+                continue;
+            }
+            return Err(err(
+                path,
+                format!(
+                    "line {line_no}: expected the header `Laser id,Elevation,Azimuth` (or `Channel,...`), found `{line}`"
+                ),
+            ));
+        }
+        if cells.len() != 3 {
+            return Err(err(
+                path,
+                format!("line {line_no}: expected 3 values `{id_field},Elevation,Azimuth`, found {}", cells.len()),
+            ));
+        }
+        let id = cells[0].parse::<u32>().map_err(|_| {
+            err(path, format!("line {line_no}: `{id_field}` `{}` is not a whole number >= 1", cells[0]))
+        })?;
+        let angle = |name: &str, cell: &str| -> Result<f64, CalibrationError> {
+            let v = number(path, &format!("line {line_no}: `{name}`"), cell)?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(err(path, format!("line {line_no}: `{name}` is {v}, not a finite angle")))
+            }
+        };
+        let elevation = angle("Elevation", cells[1])?;
+        let azimuth = angle("Azimuth", cells[2])?;
+        rows.push((line_no, id, elevation, azimuth));
+    }
+    if rows.is_empty() {
+        return Err(err(path, "no lasers after the header"));
+    }
+    let mut line_of_id: std::collections::BTreeMap<u32, usize> = std::collections::BTreeMap::new();
+    for &(line_no, id, _, _) in &rows {
+        if id == 0 {
+            return Err(err(path, format!("line {line_no}: `{id_field}` 0; ids run from 1")));
+        }
+        if let Some(first) = line_of_id.insert(id, line_no) {
+            return Err(err(path, format!("line {line_no}: `{id_field}` {id} repeated (first on line {first})")));
+        }
+    }
+    // Distinct ids >= 1, sorted: the first id that is not its rank + 1 shows the missing one.
+    if let Some((rank, _)) = line_of_id.keys().enumerate().find(|&(rank, &id)| id as usize != rank + 1) {
+        let n = rows.len();
+        return Err(err(path, format!("`{id_field}` {} missing (ids must run 1 ..= {n} without gaps)", rank + 1)));
+    }
+    rows.sort_by_key(|r| r.1);
+    Ok(Calibration {
+        columns: None,
+        lasers: rows
+            .iter()
+            .map(|&(_, _, elevation_deg, azimuth)| LaserCalibration {
+                elevation_deg,
+                azimuth_offset_deg: -azimuth,
+                ..Default::default()
+            })
             .collect(),
     })
 }

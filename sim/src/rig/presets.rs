@@ -12,6 +12,7 @@
 //! | `hdl64e-roof` | HDL-64E base at x 1.3, z 1.80 (its beams start 0.14-0.22 m higher). |
 //! | `os1-64-roof` | OS1-64 gen1, 1024 x 10 Hz, at x 1.3, z 1.85. |
 //! | `os1-128-roof` | OS1-128, 2048 x 10 Hz, at x 1.3, z 1.85. |
+//! | `hdl32e-roof`, `vlp32c-roof`, `vls128-roof`, `os0-128-roof`, `os2-128-roof`, `pandar64-roof`, `pandar-xt32-roof`, `rs-helios-5515-roof` | the catalogued sensor of that name ([`crate::sensor::catalogue`]) with its defaults (10 Hz, strongest return; Ouster 1024 columns) at x 1.3, z 1.85. |
 //!
 //! Why stacking rather than interleaving for the roof LUX: each LUX layer is a 0.8 deg tall beam,
 //! so four fans offset by 0.2 deg would illuminate the same 3.2 deg slice four times; offsetting
@@ -32,6 +33,14 @@ pub const PRESETS: &[&str] = &[
     "hdl64e-roof",
     "os1-64-roof",
     "os1-128-roof",
+    "hdl32e-roof",
+    "vlp32c-roof",
+    "vls128-roof",
+    "os0-128-roof",
+    "os2-128-roof",
+    "pandar64-roof",
+    "pandar-xt32-roof",
+    "rs-helios-5515-roof",
 ];
 
 /// A sensor of `model` with its defaults at `mount`.
@@ -85,6 +94,14 @@ pub fn preset(name: &str) -> Result<Rig> {
         "hdl64e-roof" => roof("hdl64e", 1.80),
         "os1-64-roof" => roof("os1-64", 1.85),
         "os1-128-roof" => roof("os1-128", 1.85),
+        "hdl32e-roof" => roof("hdl32e", 1.85),
+        "vlp32c-roof" => roof("vlp32c", 1.85),
+        "vls128-roof" => roof("vls128", 1.85),
+        "os0-128-roof" => roof("os0-128", 1.85),
+        "os2-128-roof" => roof("os2-128", 1.85),
+        "pandar64-roof" => roof("pandar64", 1.85),
+        "pandar-xt32-roof" => roof("pandar-xt32", 1.85),
+        "rs-helios-5515-roof" => roof("rs-helios-5515", 1.85),
         _ => return Err(SimError::UnknownName { kind: "rig", name: name.to_string(), known: PRESETS.join(", ") }),
     };
     Ok(Rig { name: name.to_string(), sensors: sensors? })
