@@ -272,7 +272,8 @@ fn bad_messages_are_skipped_and_named_and_bad_bags_refused() {
 
     // Without --topic, the bag's one PointCloud2 topic is read.
     let o1 = tmp.path().join("no-topic");
-    let stdout = ok(&["classify", "--method", "nitsch", "--rig", "vlp16-roof", "--input", b, "--out", o1.to_str().unwrap()]);
+    let stdout =
+        ok(&["classify", "--method", "nitsch", "--rig", "vlp16-roof", "--input", b, "--out", o1.to_str().unwrap()]);
     assert!(stdout.contains("3 messages of /points classified, 2 skipped"), "{stdout}");
     assert_eq!(files_in(&o1, "ground").len(), 3);
     // With two PointCloud2 topics, --topic is needed: refused, the topics listed.
@@ -283,13 +284,14 @@ fn bad_messages_are_skipped_and_named_and_bad_bags_refused() {
     }
     w.finish().unwrap();
     let o4 = tmp.path().join("two-out");
-    let err = fails(&["classify", "--method", "nitsch", "--input", two.to_str().unwrap(), "--out", o4.to_str().unwrap()]);
-    assert!(err.contains("give --topic") && err.contains("/front/points (1 messages), /rear/points (1 messages)"), "{err}");
+    let err =
+        fails(&["classify", "--method", "nitsch", "--input", two.to_str().unwrap(), "--out", o4.to_str().unwrap()]);
+    assert!(
+        err.contains("give --topic") && err.contains("/front/points (1 messages), /rear/points (1 messages)"),
+        "{err}"
+    );
     // An unknown topic, one of another type: refused, the PointCloud2 topics listed.
-    for (topic, needle) in [
-        (Some("/nope"), "no PointCloud2 topic `/nope`"),
-        (Some("/tf"), "tf2_msgs/msg/TFMessage"),
-    ] {
+    for (topic, needle) in [(Some("/nope"), "no PointCloud2 topic `/nope`"), (Some("/tf"), "tf2_msgs/msg/TFMessage")] {
         let o2 = tmp.path().join("refused");
         let mut args = vec!["classify", "--method", "nitsch", "--input", b, "--out", o2.to_str().unwrap()];
         if let Some(t) = topic {

@@ -44,7 +44,8 @@ fn read_all(path: &Path, topic: Option<&str>, setup: &SensorSetup) -> Vec<(usize
     let mut out = Vec::new();
     while let Some(f) = frames.next_frame() {
         let f = f.unwrap();
-        let ground = method.classify(&classifier::FrameInput { index: f.index, cloud: f.cloud, world_from_vehicle: None });
+        let ground =
+            method.classify(&classifier::FrameInput { index: f.index, cloud: f.cloud, world_from_vehicle: None });
         let decisions = f.decisions_per_point(&ground.unwrap());
         out.push((f.index, f.provenance.layout, f.cloud.returns(), decisions));
     }
@@ -117,7 +118,9 @@ fn every_input_kind_reads_as_ordered_frames_with_provenance() {
     let pcd = sim::io::pcd::read(&files.join("frame_000001.pcd")).unwrap();
     assert_eq!((f.cloud.rows, f.cloud.cols), (pcd.rows, pcd.cols));
     assert_eq!(f.provenance.to_string(), format!("{}#/points[0]", bag.display()));
-    assert!(f.cloud.point_in_vehicle.iter().zip(&pcd.point_in_vehicle).all(|(a, b)| a == b || (a.is_nan() && b.is_nan())));
+    assert!(
+        f.cloud.point_in_vehicle.iter().zip(&pcd.point_in_vehicle).all(|(a, b)| a == b || (a.is_nan() && b.is_nan()))
+    );
     // Two PointCloud2 topics and none named: refused, both listed; a topic for a file: refused.
     let two = d.join("two");
     let mut w = BagWriter::create(&two).unwrap();
@@ -156,8 +159,17 @@ fn a_bag_cut_short_reads_as_the_first_messages_of_the_whole_bag() {
         while let Some(f) = frames.next_frame() {
             match f {
                 Ok(f) => {
-                    let ground = method.classify(&classifier::FrameInput { index: f.index, cloud: f.cloud, world_from_vehicle: None });
-                    got.push((f.index, f.provenance.layout, f.cloud.returns(), f.decisions_per_point(&ground.unwrap())));
+                    let ground = method.classify(&classifier::FrameInput {
+                        index: f.index,
+                        cloud: f.cloud,
+                        world_from_vehicle: None,
+                    });
+                    got.push((
+                        f.index,
+                        f.provenance.layout,
+                        f.cloud.returns(),
+                        f.decisions_per_point(&ground.unwrap()),
+                    ));
                 }
                 Err(e) => error = Some(e.to_string()),
             }

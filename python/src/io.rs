@@ -95,10 +95,7 @@ fn read_file(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
         RecordingError::File(e) => sim_error(e),
         RecordingError::Unsupported { .. } => value_error(
             "path",
-            format!(
-                "{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label)",
-                path.display()
-            ),
+            format!("{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label)", path.display()),
         ),
         e => value_error("path", e),
     })?;

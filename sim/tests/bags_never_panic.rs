@@ -48,7 +48,8 @@ fn read_bag(bytes: &[u8]) -> (Option<usize>, bool) {
         let name = Path::new("m");
         let ok = m.is_ok_and(|m| {
             m.decode().is_ok_and(|pc| {
-                frame(name, &pc, None).is_ok_and(|f| f.read_into(&mut OrderedCloud::default(), None, Default::default()).is_ok())
+                frame(name, &pc, None)
+                    .is_ok_and(|f| f.read_into(&mut OrderedCloud::default(), None, Default::default()).is_ok())
             })
         });
         read = read.filter(|_| ok).map(|n| n + 1);

@@ -202,7 +202,8 @@ fn run_bag(
         if frame.index >= take {
             break;
         }
-        let labelled = frame.message.and_then(|m| m.decode().ok()).is_some_and(|pc| pc.fields.iter().any(|f| f.name == "label"));
+        let labelled =
+            frame.message.and_then(|m| m.decode().ok()).is_some_and(|pc| pc.fields.iter().any(|f| f.name == "label"));
         if !labelled {
             bail!("`{}` {topic} message {}: no `label` field: scoring needs labels", args.dir.display(), frame.index);
         }

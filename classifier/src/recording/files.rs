@@ -141,7 +141,8 @@ impl FrameReader {
         let name = provenance.name();
         let name = name.as_path();
         let cloud = message.decode().map_err(bad)?;
-        let frame = sim::io::ros2::pointcloud2::frame(name, &cloud, message.groundtruth_comment.as_deref()).map_err(bad)?;
+        let frame =
+            sim::io::ros2::pointcloud2::frame(name, &cloud, message.groundtruth_comment.as_deref()).map_err(bad)?;
         let Some(setup) = setup else {
             frame.read_into(self.cloud.cloud_mut(), None, Affine3A::IDENTITY).map_err(|e| bad(e.to_string()))?;
             return Ok(t0.elapsed().as_secs_f64() * 1e3);
@@ -213,9 +214,8 @@ fn order_pcd(
         {
             return Err(RecordingError::CalibrationRows { name: path.display().to_string(), rows, lasers });
         }
-        read_organized_into(frame, setup.vehicle_from_sensor, cloud.cloud_mut(), report).map_err(|error| {
-            RecordingError::Ordering { what: format!("the rows of `{}`", path.display()), error }
-        })?;
+        read_organized_into(frame, setup.vehicle_from_sensor, cloud.cloud_mut(), report)
+            .map_err(|error| RecordingError::Ordering { what: format!("the rows of `{}`", path.display()), error })?;
         return Ok((read_ms, true));
     }
     let info = frame.read_into(file_cloud, None, Affine3A::IDENTITY)?;

@@ -92,7 +92,11 @@ pub fn list_files(input: &Path) -> Result<Vec<InputFile>, RecordingError> {
             .iter()
             .map(|f| {
                 let mat = Mat4::from_cols_array_2d(&f.world_from_vehicle).transpose();
-                InputFile { index: f.index, path: input.join(&f.file), world_from_vehicle: Some(Affine3A::from_mat4(mat)) }
+                InputFile {
+                    index: f.index,
+                    path: input.join(&f.file),
+                    world_from_vehicle: Some(Affine3A::from_mat4(mat)),
+                }
             })
             .collect());
     }

@@ -162,7 +162,9 @@ impl RecordingError {
 /// [`SensorSetup::new`]).
 pub fn sensor_setup(rig: Option<&str>, calibration: Option<&Path>) -> Result<SensorSetup, RecordingError> {
     let rig_value = match rig {
-        Some(name) => Some(sim::Rig::load(name).map_err(|error| RecordingError::Rig { name: name.to_string(), error })?),
+        Some(name) => {
+            Some(sim::Rig::load(name).map_err(|error| RecordingError::Rig { name: name.to_string(), error })?)
+        }
         None => None,
     };
     SensorSetup::new(rig_value.as_ref(), calibration).map_err(|error| RecordingError::Setup {
@@ -324,7 +326,8 @@ impl Frames<'_> {
                     Err(e) => return Some(Err(e.into())),
                 };
                 let topic = clouds.topic().to_string();
-                self.provenance = Provenance::message(self.recording.path.clone(), &topic, message.index, message.log_time_ns);
+                self.provenance =
+                    Provenance::message(self.recording.path.clone(), &topic, message.index, message.log_time_ns);
                 self.world_from_vehicle = None;
                 let setup = match self.ordering {
                     Ordering::Ordered(setup) => Some(setup),

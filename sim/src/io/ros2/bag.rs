@@ -541,7 +541,8 @@ impl Bag {
                     let m = match m {
                         Ok(m) => m,
                         Err(e) if e.truncated => {
-                            let cut = Truncation { file: file.clone(), messages: index, last_log_time_ns, reason: e.message };
+                            let cut =
+                                Truncation { file: file.clone(), messages: index, last_log_time_ns, reason: e.message };
                             if sender.send(Event::Truncated(cut)).is_err() {
                                 return;
                             }
@@ -558,7 +559,12 @@ impl Bag {
                     }
                     let ty = m.channel.schema.as_str();
                     if ty != POINTCLOUD2 || m.channel.message_encoding != "cdr" {
-                        let _ = sender.send(Event::Failed(Self::wrong_type(file, &wanted, ty, &m.channel.message_encoding)));
+                        let _ = sender.send(Event::Failed(Self::wrong_type(
+                            file,
+                            &wanted,
+                            ty,
+                            &m.channel.message_encoding,
+                        )));
                         return;
                     }
                     last_log_time_ns = Some(m.log_time_ns);
@@ -585,7 +591,6 @@ impl Bag {
             done: false,
         })
     }
-
 }
 
 /// What the reading thread of [`Bag::clouds`] sends.
@@ -620,7 +625,9 @@ impl std::fmt::Display for Truncation {
                 self.last_log_time_ns.map_or(String::new(), |t| format!(" (log time {t} ns)")),
                 self.messages
             ),
-            None => write!(f, "`{}` is cut short ({}) before any message of the topic", self.file.display(), self.reason),
+            None => {
+                write!(f, "`{}` is cut short ({}) before any message of the topic", self.file.display(), self.reason)
+            }
         }
     }
 }
@@ -677,7 +684,9 @@ impl Iterator for BagClouds {
                     let error = self.bag.no_such_topic(&self.topic);
                     return Some(Err(match self.truncations.first() {
                         None => error,
-                        Some(cut) => bag_error(&self.bag.path, format!("no whole message of `{}`: {cut}; {error}", self.topic)),
+                        Some(cut) => {
+                            bag_error(&self.bag.path, format!("no whole message of `{}`: {cut}; {error}", self.topic))
+                        }
                     }));
                 }
             }

@@ -163,8 +163,8 @@ pub fn frame<'a>(
     }
     pad(step - at, &mut decls);
     let grid = comment.and_then(grid_of_comment);
-    let header = layout(path, &decls, width, height, width * height, DataKind::Binary, 0, grid)
-        .map_err(|e| e.to_string())?;
+    let header =
+        layout(path, &decls, width, height, width * height, DataKind::Binary, 0, grid).map_err(|e| e.to_string())?;
     let body = if cloud.row_step as usize == row_bytes {
         Cow::Borrowed(&cloud.data[..])
     } else {
