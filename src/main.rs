@@ -3,7 +3,6 @@
 
 mod alloc;
 mod cli;
-mod input_bytes;
 mod plot;
 
 use clap::Parser;

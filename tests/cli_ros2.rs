@@ -3,9 +3,12 @@
 //!   counts, the same bytes at 1 and 2 threads; `dataset` writes one per sequence;
 //! - `classify`, `eval --dataset` and `bench classify` read a bag (ours, or one our writer makes of
 //!   hand-built clouds) and decide as they do on the same clouds as PCD files;
-//! - bad input: a missing or unknown topic (the topics listed), a topic of another type, a JSON or
-//!   ROS 1 channel, a truncated file, and bad messages among good ones (classified, the bad ones
-//!   counted and named by file, topic and index), with nothing half-written.
+//! - a bag with one PointCloud2 topic is read without `--topic`; a file cut short is read up to its
+//!   last whole message with a warning naming it;
+//! - bad input: a missing topic among several, an unknown topic (the topics listed), a topic of
+//!   another type, a JSON or ROS 1 channel, a file cut before its first message, and bad messages
+//!   among good ones (classified, the bad ones counted and named by file, topic and index), with
+//!   nothing half-written.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -41,6 +44,20 @@ fn scan(out: &Path, rig: &str, layout: &str, extra: &[&str]) -> serde_json::Valu
     serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap()
 }
 
+/// Every message of `topic` in the bag at `path` as (index, CDR bytes), read by the library's
+/// reader of recordings (as stored).
+fn messages(path: &Path, topic: &str) -> Vec<(usize, Vec<u8>)> {
+    let recording = classifier::recording::Recording::open(path, Some(topic)).unwrap();
+    let mut frames = recording.frames(classifier::recording::Ordering::AsStored).unwrap();
+    let mut out = Vec::new();
+    while let Some(frame) = frames.next_frame() {
+        let frame = frame.unwrap();
+        let m = frame.message.unwrap();
+        out.push((m.index, m.cdr.clone()));
+    }
+    out
+}
+
 fn files_in(dir: &Path, ext: &str) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|d| {
@@ -63,13 +80,13 @@ fn a_scan_bag_holds_the_manifest_counts_and_classifies_as_its_pcd_files() {
         assert_eq!(names, ["/roof/points", "/tf", "/tf_static"], "{layout}");
         assert_eq!(topics.iter().map(|t| t.count).collect::<Vec<_>>(), [3, 3, 1]);
         // Every message's width x height is the manifest's count for it.
-        let mut counts = Vec::new();
-        bag.for_each_cloud("/roof/points", |m| {
-            let pc = m.decode().unwrap();
-            counts.push((pc.width * pc.height) as u64);
-            Ok(())
-        })
-        .unwrap();
+        let counts: Vec<u64> = messages(&dir.join("bag"), "/roof/points")
+            .iter()
+            .map(|(_, cdr)| {
+                let pc = sim::io::ros2::messages::from_cdr::<PointCloud2<'_>>(cdr).unwrap();
+                (pc.width * pc.height) as u64
+            })
+            .collect();
         let listed: Vec<u64> = manifest["frames"]
             .as_array()
             .unwrap()
@@ -109,18 +126,14 @@ fn a_scan_bag_holds_the_manifest_counts_and_classifies_as_its_pcd_files() {
             }
             // The result bag: the same messages, each with a `ground` field holding the decisions
             // (our layout's own `ground`, the truth, renamed `ground_truth`).
-            let out_bag = Bag::open(&a.join("ground_bag")).unwrap();
-            out_bag
-                .for_each_cloud("/roof/points", |m| {
-                    let pc = m.decode().unwrap();
-                    let f = pc.fields.iter().find(|f| f.name == "ground").unwrap();
-                    let decisions: Vec<u8> =
-                        pc.data.chunks_exact(pc.point_step as usize).map(|p| p[f.offset as usize]).collect();
-                    assert_eq!(decisions, std::fs::read(a.join(format!("frame_{:06}.ground", m.index))).unwrap());
-                    assert_eq!(pc.fields.iter().any(|f| f.name == "ground_truth"), layout == "groundtruth");
-                    Ok(())
-                })
-                .unwrap();
+            for (index, cdr) in messages(&a.join("ground_bag"), "/roof/points") {
+                let pc = sim::io::ros2::messages::from_cdr::<PointCloud2<'_>>(&cdr).unwrap();
+                let f = pc.fields.iter().find(|f| f.name == "ground").unwrap();
+                let decisions: Vec<u8> =
+                    pc.data.chunks_exact(pc.point_step as usize).map(|p| p[f.offset as usize]).collect();
+                assert_eq!(decisions, std::fs::read(a.join(format!("frame_{index:06}.ground"))).unwrap());
+                assert_eq!(pc.fields.iter().any(|f| f.name == "ground_truth"), layout == "groundtruth");
+            }
         }
     }
 }
@@ -257,12 +270,28 @@ fn bad_messages_are_skipped_and_named_and_bad_bags_refused() {
     let err = fails(&["bench", "classify", "--method", "nitsch", "--input", b, "--topic", "/points", "--repeats", "1"]);
     assert!(err.contains("/points message 1"), "{err}");
 
-    // A missing topic, an unknown one, one of another type: refused, the PointCloud2 topics listed.
-    for (topic, needle) in [
-        (None, "give --topic"),
-        (Some("/nope"), "no PointCloud2 topic `/nope`"),
-        (Some("/tf"), "tf2_msgs/msg/TFMessage"),
-    ] {
+    // Without --topic, the bag's one PointCloud2 topic is read.
+    let o1 = tmp.path().join("no-topic");
+    let stdout =
+        ok(&["classify", "--method", "nitsch", "--rig", "vlp16-roof", "--input", b, "--out", o1.to_str().unwrap()]);
+    assert!(stdout.contains("3 messages of /points classified, 2 skipped"), "{stdout}");
+    assert_eq!(files_in(&o1, "ground").len(), 3);
+    // With two PointCloud2 topics, --topic is needed: refused, the topics listed.
+    let two = tmp.path().join("two");
+    let mut w = BagWriter::create(&two).unwrap();
+    for t in ["/front/points", "/rear/points"] {
+        w.write_pointcloud(t, &cloud(8, 360), 0, &BTreeMap::new()).unwrap();
+    }
+    w.finish().unwrap();
+    let o4 = tmp.path().join("two-out");
+    let err =
+        fails(&["classify", "--method", "nitsch", "--input", two.to_str().unwrap(), "--out", o4.to_str().unwrap()]);
+    assert!(
+        err.contains("give --topic") && err.contains("/front/points (1 messages), /rear/points (1 messages)"),
+        "{err}"
+    );
+    // An unknown topic, one of another type: refused, the PointCloud2 topics listed.
+    for (topic, needle) in [(Some("/nope"), "no PointCloud2 topic `/nope`"), (Some("/tf"), "tf2_msgs/msg/TFMessage")] {
         let o2 = tmp.path().join("refused");
         let mut args = vec!["classify", "--method", "nitsch", "--input", b, "--out", o2.to_str().unwrap()];
         if let Some(t) = topic {
@@ -275,12 +304,23 @@ fn bad_messages_are_skipped_and_named_and_bad_bags_refused() {
         }
         assert!(files_in(&o2, "ground").is_empty() && !o2.join("ground_bag").exists(), "nothing written: {err}");
     }
-    // A truncated file: refused, naming the file.
+    // A file cut short (its summary and footer lost, as when a recorder is killed): read up to
+    // its last whole message, with a warning naming it; exit 0.
     let mcap = bag.join("mixed_0.mcap");
     let bytes = std::fs::read(&mcap).unwrap();
     let cut = tmp.path().join("cut.mcap");
-    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() - 30]).unwrap();
     let o3 = tmp.path().join("cut-out");
+    let out = run(&["classify", "--method", "nitsch", "--input", cut.to_str().unwrap(), "--out", o3.to_str().unwrap()]);
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{stderr}");
+    for text in [&stdout, &stderr] {
+        assert!(text.contains("cut.mcap") && text.contains("cut short") && text.contains("message 4"), "{text}");
+    }
+    assert_eq!(files_in(&o3, "ground").len(), 3);
+    // Cut before its first whole message: nothing to classify, refused naming the file.
+    std::fs::write(&cut, &bytes[..60]).unwrap();
+    let o5 = tmp.path().join("cut-early");
     let err = fails(&[
         "classify",
         "--method",
@@ -290,10 +330,10 @@ fn bad_messages_are_skipped_and_named_and_bad_bags_refused() {
         "--topic",
         "/points",
         "--out",
-        o3.to_str().unwrap(),
+        o5.to_str().unwrap(),
     ]);
-    assert!(err.contains("cut.mcap") && (err.contains("truncated") || err.contains("corrupt")), "{err}");
-    assert!(files_in(&o3, "ground").is_empty() && !o3.join("ground_bag").exists(), "{err}");
+    assert!(err.contains("cut.mcap") && err.contains("cut short"), "{err}");
+    assert!(files_in(&o5, "ground").is_empty() && !o5.join("ground_bag").exists(), "{err}");
     // Not a bag at all.
     let junk = tmp.path().join("junk.mcap");
     std::fs::write(&junk, b"not an mcap file at all").unwrap();

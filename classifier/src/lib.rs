@@ -7,7 +7,9 @@
 //! and the cluster rules of Sec. III-B) -> a ground decision per cell ([`nitsch`]). The baselines
 //! ([`baselines::ransac`], [`baselines::grid`]) and the method live behind one trait in
 //! [`methods`], chosen by name from [`METHODS`]. [`metrics`] scores decisions against ground truth;
-//! [`ordering`] turns unordered clouds (KITTI `.bin`) into grids; [`synthetic`] builds analytic test
+//! [`ordering`] turns unordered clouds (KITTI `.bin`) into grids; [`recording`] reads any
+//! recording the project takes (files, scan directories, ROS 2 bags) as ordered frames with their
+//! provenance; [`registry`] resolves a method by name with its model, once; [`synthetic`] builds analytic test
 //! clouds. [`mcdaniel`] is the forest method of McDaniel et al. (min-z columns, eight features, a
 //! linear SVM); [`sensor_origin`] estimates sensor origins from a cloud's (point, range) pairs.
 //!
@@ -24,6 +26,8 @@ pub mod methods;
 pub mod metrics;
 pub mod nitsch;
 pub mod ordering;
+pub mod recording;
+pub mod registry;
 pub mod sensor_origin;
 pub mod synthetic;
 
@@ -32,3 +36,4 @@ pub use mcdaniel::{McDaniel, McDanielModel, McDanielParams};
 pub use methods::{FrameInput, GroundClassifier, METHODS, learned_with_model, mcdaniel_with_model, method_by_name};
 pub use metrics::{Confusion, Evaluation, Scores};
 pub use nitsch::{Nitsch, NitschParams};
+pub use registry::{MethodError, MethodOptions, method, takes_model};

@@ -13,36 +13,28 @@ use crate::args::type_name;
 use crate::error::{classify_error, type_error, value_error};
 use crate::frame::{Frame, grid_array};
 
-/// The method `name` with its default parameters, as the command line builds it: `model` is a
-/// trained model file for `mcdaniel` (default: the bundled forest model) or `learned` (default:
-/// the bundled model); RANSAC is seeded with the frame index.
-pub fn method(name: &str, model: Option<&PathBuf>) -> PyResult<Box<dyn GroundClassifier + Send>> {
-    let exists = |path: &PathBuf| {
-        if path.is_file() {
-            Ok(())
-        } else {
-            Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!("model: {}: no such file", path.display())))
-        }
-    };
-    match model {
-        None => classifier::method_by_name(name, 0).map_err(classify_error),
-        Some(path) if name == "mcdaniel" => {
-            exists(path)?;
-            let model = classifier::McDanielModel::load(path)
-                .map_err(|e| classify_error(classifier::ClassifyError::Model(e)))?;
-            classifier::mcdaniel_with_model(model, classifier::McDanielParams::default()).map_err(classify_error)
-        }
-        Some(path) if name == "learned" => {
-            exists(path)?;
-            let model = classifier::learned::LearnedModel::load(path)
-                .map_err(|e| classify_error(classifier::ClassifyError::LearnedModel(e)))?;
-            classifier::learned_with_model(model).map_err(classify_error)
-        }
-        Some(path) => Err(value_error(
-            "model",
-            format!("`{}` applies to `mcdaniel` and `learned`, not to `{name}`", path.display()),
-        )),
+/// A method that could not be resolved, as a Python exception naming what is wrong: `ValueError`
+/// for an unknown name or a model given to a method that takes none, `FileNotFoundError` for a
+/// missing model file, the model's own error (`ValueError`, `OSError`) for one that cannot be
+/// loaded.
+pub fn method_error(e: classifier::MethodError) -> PyErr {
+    use classifier::MethodError;
+    match e {
+        MethodError::TakesNoModel { .. } => value_error("model", e),
+        MethodError::ModelMissing { .. } => pyo3::exceptions::PyFileNotFoundError::new_err(format!("model: {e}")),
+        MethodError::McDanielModel(m) => classify_error(classifier::ClassifyError::Model(m)),
+        MethodError::LearnedModel(m) => classify_error(classifier::ClassifyError::LearnedModel(m)),
+        MethodError::Build { error, .. } => classify_error(error),
+        MethodError::Unknown { .. } => value_error("method", e),
     }
+}
+
+/// The method `name` with its default parameters, as the command line builds it
+/// ([`classifier::method`]): `model` is a trained model file for `mcdaniel` (default: the bundled
+/// forest model) or `learned` (default: the bundled model); RANSAC is seeded with the frame index.
+pub fn method(name: &str, model: Option<&PathBuf>) -> PyResult<Box<dyn GroundClassifier + Send>> {
+    classifier::method(name, &classifier::MethodOptions { seed: 0, model: model.map(PathBuf::as_path) })
+        .map_err(method_error)
 }
 
 /// Classifies `frame` with our method `method` (`groundtruth.METHODS`: `nitsch`, `ransac`, `grid`,

@@ -60,11 +60,16 @@ pub fn eval_dataset<'py>(
     if let Some(g) = &ground {
         proto = proto.with_ground(g).map_err(dataset_error)?;
     }
-    // Unknown methods and bad models are refused before any frame is read.
-    let takes_model = |name: &str| name == "mcdaniel" || name == "learned";
-    for m in &methods {
-        crate::classify::method(m, model.as_ref().filter(|_| takes_model(m)))?;
-    }
+    // Unknown methods and bad models are refused before any frame is read; each model file is
+    // read once, every instance (one per sequence) built from it.
+    let resolved: Vec<classifier::registry::ResolvedMethod> = methods
+        .iter()
+        .map(|m| {
+            let model = model.as_deref().filter(|_| classifier::takes_model(m));
+            classifier::registry::resolve(m, &classifier::MethodOptions { seed: 0, model })
+        })
+        .collect::<Result<_, _>>()
+        .map_err(crate::classify::method_error)?;
     let rig_value = match &rig {
         Some(r) => Some(sim::Rig::load(r).map_err(|e| value_error("rig", e))?),
         None => None,
@@ -83,17 +88,10 @@ pub fn eval_dataset<'py>(
             protocol: &proto,
             max_frames_per_sequence: max_frames,
         };
-        let model = model.clone();
-        let make = move |name: &str| -> classifier::Result<Box<dyn classifier::GroundClassifier + Send>> {
-            match model.as_ref().filter(|_| takes_model(name)) {
+        let make = |name: &str| -> classifier::Result<Box<dyn classifier::GroundClassifier + Send>> {
+            match resolved.iter().find(|r| r.name() == name) {
+                Some(r) => r.build(),
                 None => classifier::method_by_name(name, 0),
-                Some(p) if name == "learned" => classifier::learned_with_model(
-                    classifier::learned::LearnedModel::load(p).map_err(classifier::ClassifyError::LearnedModel)?,
-                ),
-                Some(p) => classifier::mcdaniel_with_model(
-                    classifier::McDanielModel::load(p).map_err(classifier::ClassifyError::Model)?,
-                    classifier::McDanielParams::default(),
-                ),
             }
         };
         let scores = evaluate(&layout, &methods, &make, &options, |_| Ok(()))?;

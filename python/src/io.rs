@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use classifier::recording::{Ordering, Recording, RecordingError, read_as_stored};
 use groundtruth_scenario::Scan;
 use pyo3::prelude::*;
 use sim::io::pcd::PcdLayout;
@@ -13,6 +14,7 @@ use crate::frame::Frame;
 /// The formats `write` takes.
 pub const WRITE_FORMATS: [&str; 6] = ["pcd", "pcd-ascii", "ply", "kitti", "las", "mcap"];
 
+/// The lower-case extension of `path` (empty without one).
 fn extension(path: &Path) -> String {
     path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
 }
@@ -25,7 +27,10 @@ fn extension(path: &Path) -> String {
 ///
 /// A ROS 2 bag (an `.mcap` file or a rosbag2 directory) gives a list of Frames, one per
 /// `sensor_msgs/msg/PointCloud2` message of `topic` (optional where the bag has one such topic),
-/// each read as the PCD of the same cloud would be.
+/// each read as the PCD of the same cloud would be. A bag cut short is read up to its last whole
+/// message, with a `UserWarning` naming the last message read.
+///
+/// Files and bags are read by the library's reader (`classifier::recording`), as stored.
 #[pyfunction]
 #[pyo3(signature = (path, topic=None))]
 pub fn read<'py>(py: Python<'py>, path: PathBuf, topic: Option<String>) -> PyResult<Bound<'py, PyAny>> {
@@ -45,37 +50,24 @@ pub fn read<'py>(py: Python<'py>, path: PathBuf, topic: Option<String>) -> PyRes
 /// The PointCloud2 messages of a bag's topic as Frames.
 fn read_bag(py: Python<'_>, path: &Path, topic: Option<String>) -> PyResult<Vec<Frame>> {
     let p = path.to_path_buf();
-    let clouds = py
-        .detach(move || -> Result<Vec<sim::OrderedCloud>, String> {
-            let bag = sim::io::ros2::Bag::open(&p).map_err(|e| e.to_string())?;
-            let topic = match topic {
-                Some(t) => t,
-                None => {
-                    let topics = bag.pointcloud_topics().map_err(|e| e.to_string())?;
-                    match topics.as_slice() {
-                        [one] => one.name.clone(),
-                        _ => {
-                            let names: Vec<&str> = topics.iter().map(|t| t.name.as_str()).collect();
-                            return Err(format!(
-                                "topic: give one of the bag's PointCloud2 topics: {}",
-                                names.join(", ")
-                            ));
-                        }
-                    }
-                }
-            };
+    let (clouds, warnings) = py
+        .detach(move || -> Result<(Vec<sim::OrderedCloud>, Vec<String>), RecordingError> {
+            let recording = Recording::open(&p, topic.as_deref())?;
+            let mut frames = recording.frames(Ordering::AsStored)?;
             let mut out = Vec::new();
-            bag.for_each_cloud(&topic, |m| {
-                let bad = |e: String| sim::SimError::bad_file(&p, format!("{topic} message {}: {e}", m.index));
-                let pc = m.decode().map_err(bad)?;
-                let pcd = sim::io::ros2::pointcloud2::to_pcd(&pc, m.groundtruth_comment.as_deref()).map_err(bad)?;
-                out.push(sim::io::pcd::read_bytes(&p, &pcd)?);
-                Ok(())
-            })
-            .map_err(|e| e.to_string())?;
-            Ok(out)
+            while let Some(frame) = frames.next_frame() {
+                out.push(frame?.cloud.clone());
+            }
+            Ok((out, frames.warnings().to_vec()))
         })
-        .map_err(|e| value_error("path", e))?;
+        .map_err(|e| match e {
+            RecordingError::Topic(m) => value_error("topic", m),
+            e => value_error("path", e),
+        })?;
+    for w in warnings {
+        let message = std::ffi::CString::new(w).unwrap_or_default();
+        PyErr::warn(py, py.get_type::<pyo3::exceptions::PyUserWarning>().as_any(), &message, 1)?;
+    }
     let name = path.display().to_string();
     Ok(clouds.into_iter().map(|cloud| frame_of(cloud, &name)).collect())
 }
@@ -95,32 +87,18 @@ fn frame_of(cloud: sim::OrderedCloud, name: &str) -> Frame {
 
 /// Reads one point-cloud file (see [`read`]).
 fn read_file(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
-    let ext = extension(&path);
     if !path.is_file() {
         return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!("path: {}: no such file", path.display())));
     }
     let p = path.clone();
-    let cloud = py
-        .detach(move || match ext.as_str() {
-            "pcd" => Some(sim::io::pcd::read(&p)),
-            "ply" => Some(sim::io::ply::read(&p)),
-            "las" => Some(sim::io::las::read(&p)),
-            "bin" => {
-                let label = p.with_extension("label");
-                Some(sim::io::kitti::read(&p, label.is_file().then_some(label.as_path())))
-            }
-            _ => None,
-        })
-        .ok_or_else(|| {
-            value_error(
-                "path",
-                format!(
-                    "{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label)",
-                    path.display()
-                ),
-            )
-        })?
-        .map_err(sim_error)?;
+    let cloud = py.detach(move || read_as_stored(&p)).map_err(|e| match e {
+        RecordingError::File(e) => sim_error(e),
+        RecordingError::Unsupported { .. } => value_error(
+            "path",
+            format!("{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label)", path.display()),
+        ),
+        e => value_error("path", e),
+    })?;
     Ok(frame_of(cloud, &path.display().to_string()))
 }
 

@@ -15,6 +15,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use classifier::FrameInput;
+use classifier::recording::{self, FrameReader, Ordering, Recording};
 use sim::scan::ScanConfig;
 
 /// Arguments of `groundtruth bench classify`.
@@ -39,8 +40,8 @@ pub struct Args {
     /// Seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Time real files instead of a scan: a `.pcd` / `.bin` file or a directory of them, or a ROS 2
-    /// bag (`.mcap` or rosbag2 directory, with `--topic`).
+    /// Time real files instead of a scan: a `.pcd` / `.ply` / `.las` / `.bin` file or a directory of
+    /// them, or a ROS 2 bag (`.mcap` or rosbag2 directory; `--topic`, or its one PointCloud2 topic).
     #[arg(long)]
     input: Option<std::path::PathBuf>,
     /// With a bag as `--input`: the PointCloud2 topic.
@@ -49,7 +50,7 @@ pub struct Args {
     /// With `--input`: the sensor's calibration file, as `classify --calibration`.
     #[arg(long)]
     calibration: Option<std::path::PathBuf>,
-    /// Trained model file for `mcdaniel` (default: the bundled forest model).
+    /// Trained model file for `mcdaniel` or `learned` (default: the bundled model).
     #[arg(long)]
     model: Option<std::path::PathBuf>,
     /// Worker threads of methods that run stages in parallel (`mcdaniel`; 0 = all cores). Nitsch,
@@ -74,53 +75,38 @@ fn ms(t: Instant) -> f64 {
 
 /// Times read + order + classify on a bag's messages: each repeat is one pass over the bag (the
 /// MCAP read and its chunks' decompression included), and per message `read_ms` (the CDR decode
-/// and the conversion to PCD bytes and their parse), `order_ms` and `classify_ms`; `total_ms` per
-/// message is the pass's time over its messages.
-fn run_bag(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
-    let bag = sim::io::ros2::Bag::open(input)?;
-    let Some(topic) = args.topic.as_deref() else { anyhow::bail!("{}", super::classify_bag::topics_message(&bag)?) };
+/// and the PointCloud2's header; a driver's organized cloud is decoded in order as it is ordered),
+/// `order_ms` and `classify_ms`; `total_ms` per message is the pass's time over its messages.
+fn run_bag(args: &Args, recording: &Recording) -> anyhow::Result<()> {
+    let topic = recording.topic().unwrap_or_default();
     let rig = (args.rig != "os1-128-roof").then_some(args.rig.as_str());
-    let setup = super::classify::sensor_setup(rig, args.calibration.as_deref())?;
+    let setup = recording::sensor_setup(rig, args.calibration.as_deref())?;
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
-    let mut reader = super::classify::FrameReader::default();
     let (mut read, mut order, mut cls, mut per_message) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut messages = 0;
+    let (mut messages, mut warnings) = (0, Vec::new());
     for _ in 0..args.repeats.max(1) {
         let t_pass = Instant::now();
-        let mut fail: Option<anyhow::Error> = None;
-        let result = bag.for_each_cloud(topic, |m| {
-            let t0 = Instant::now();
-            let step = (|| -> anyhow::Result<()> {
-                let pc = m.decode().map_err(|e| anyhow::anyhow!("{topic} message {}: {e}", m.index))?;
-                let pcd = sim::io::ros2::pointcloud2::to_pcd(&pc, m.groundtruth_comment.as_deref())
-                    .map_err(|e| anyhow::anyhow!("{topic} message {}: {e}", m.index))?;
-                let name = std::path::PathBuf::from(format!("{}#{topic}[{}]", input.display(), m.index));
-                let t1 = Instant::now();
-                let parse_ms = reader.read_pcd_bytes(&name, &pcd, &setup)?;
-                let t2 = Instant::now();
-                method.classify(&FrameInput { index: m.index, cloud: reader.cloud(), world_from_vehicle: None })?;
-                cls.push(ms(t2));
-                // The CDR decode and the conversion to PCD bytes count as reading, as a file's read does.
-                let decode_ms = (t1 - t0).as_secs_f64() * 1e3;
-                read.push(decode_ms + parse_ms);
-                order.push((t2 - t1).as_secs_f64() * 1e3 - parse_ms);
-                Ok(())
-            })();
-            if let Err(e) = step {
-                fail = Some(e);
-                return Err(sim::SimError::invalid("message", m.index, "a message that classifies"));
-            }
-            Ok(())
-        });
-        if let Some(e) = fail {
-            return Err(e);
+        let mut frames = recording.frames(Ordering::Ordered(&setup))?;
+        let mut count = 0usize;
+        let mut t0 = Instant::now();
+        while let Some(frame) = frames.next_frame() {
+            let frame = frame?;
+            let t2 = Instant::now();
+            method.classify(&FrameInput { index: frame.index, cloud: frame.cloud, world_from_vehicle: None })?;
+            cls.push(ms(t2));
+            // The CDR decode and the message's header count as reading, as a file's read does.
+            read.push(frame.read_ms);
+            order.push((t2 - t0).as_secs_f64() * 1e3 - frame.read_ms);
+            count += 1;
+            t0 = Instant::now();
         }
-        messages = result?;
+        messages = count;
+        warnings = frames.warnings().to_vec();
         per_message.push(ms(t_pass) / messages.max(1) as f64);
     }
     let out = serde_json::json!({
         "method": args.method,
-        "input": input.display().to_string(),
+        "input": recording.path().display().to_string(),
         "topic": topic,
         "rig": rig,
         "messages": messages,
@@ -130,40 +116,29 @@ fn run_bag(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
         "order_ms": stats(&order),
         "classify_ms": stats(&cls),
         "total_ms": stats(&per_message),
+        "warnings": warnings,
     });
     println!("{}", serde_json::to_string_pretty(&out)?);
     Ok(())
 }
 
 /// Times read + order + classify on files.
-fn run_files(args: &Args, input: &std::path::Path) -> anyhow::Result<()> {
-    let files: Vec<std::path::PathBuf> = if input.is_dir() {
-        let mut v: Vec<_> = std::fs::read_dir(input)
-            .with_context(|| format!("reading directory `{}`", input.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("pcd" | "bin")))
-            .collect();
-        v.sort();
-        v
-    } else {
-        vec![input.to_path_buf()]
-    };
-    if files.is_empty() {
-        anyhow::bail!("no .pcd or .bin files in `{}`", input.display());
-    }
+fn run_files(args: &Args, recording: &Recording) -> anyhow::Result<()> {
+    let input = recording.path();
+    let files: Vec<std::path::PathBuf> = recording.files().iter().map(|f| f.path.clone()).collect();
     let rig = if args.rig == "os1-128-roof" && files.iter().any(|f| f.extension().is_some_and(|e| e == "bin")) {
         None
     } else {
         Some(args.rig.as_str())
     };
-    let setup = super::classify::sensor_setup(rig, args.calibration.as_deref())?;
+    let setup = recording::sensor_setup(rig, args.calibration.as_deref())?;
     let repeats = args.repeats.max(1);
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let (mut all_read, mut all_order, mut all_cls, mut all_total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut per_file = Vec::new();
     let mut all_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
     // One reader for every file and repeat, as `classify` reads a sequence: buffers are reused.
-    let mut reader = super::classify::FrameReader::default();
+    let mut reader = FrameReader::default();
     for (index, path) in files.iter().enumerate() {
         let (mut read, mut order, mut cls, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut file_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
@@ -248,10 +223,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// The benchmark inside the thread pool of `--threads`.
 fn run_in_pool(args: &Args) -> anyhow::Result<()> {
     if let Some(input) = &args.input {
-        if sim::io::ros2::is_bag(input) {
-            return run_bag(args, input);
+        let recording = Recording::open(input, args.topic.as_deref())?;
+        if recording.topic().is_some() {
+            return run_bag(args, &recording);
         }
-        return run_files(args, input);
+        return run_files(args, &recording);
     }
     let scene = super::common::load_scene_full(&args.scene, args.seed)?;
     let rig = super::common::load_rig(&args.rig)?;

@@ -89,34 +89,16 @@ pub fn scan_standing(
     sim::scan::scan(&loaded.mesh, &rig, &config).with_context(|| format!("scanning `{scene}`"))
 }
 
-/// The classification method `name` (see `groundtruth list`) with its default parameters; `model`
-/// is a trained model file for `mcdaniel` (default: the bundled forest model). `seed` seeds RANSAC.
-/// Whether the method `name` takes a trained model file (`--model`).
-pub fn takes_model(name: &str) -> bool {
-    name == "mcdaniel" || name == "learned"
-}
+pub use classifier::takes_model;
 
-/// Builds the method `name` (`seed` seeds RANSAC; `model`: a trained model file for the methods
-/// that take one, see [`takes_model`]).
+/// Builds the method `name` (see `groundtruth list`; `seed` seeds RANSAC; `model`: a trained model
+/// file for the methods that take one, see [`takes_model`]) through [`classifier::method`].
 pub fn method(
     name: &str,
     seed: u64,
     model: Option<&std::path::Path>,
 ) -> anyhow::Result<Box<dyn classifier::GroundClassifier + Send>> {
-    match model {
-        None => Ok(classifier::method_by_name(name, seed)?),
-        Some(path) if name == "mcdaniel" => {
-            let model = classifier::McDanielModel::load(path)?;
-            Ok(classifier::mcdaniel_with_model(model, classifier::McDanielParams::default())?)
-        }
-        Some(path) if name == "learned" => {
-            let model = classifier::learned::LearnedModel::load(path)?;
-            Ok(classifier::learned_with_model(model)?)
-        }
-        Some(path) => {
-            anyhow::bail!("--model `{}` applies to `mcdaniel` and `learned`, not to `{name}`", path.display())
-        }
-    }
+    Ok(classifier::method(name, &classifier::MethodOptions { seed, model })?)
 }
 
 /// Fails with the caster's device fault (out of memory, an adapter lost mid-run), if any: results

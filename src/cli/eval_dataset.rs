@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use classifier::dataset::score::{RANGE_BANDS, band_name};
 use classifier::dataset::{DatasetLayout, EvalOptions, FrameView, MethodScore, Protocol, evaluate, report};
+use classifier::recording::{self, Ordering, Recording};
+use classifier::registry::{MethodOptions, ResolvedMethod};
 
 /// What `eval --dataset` needs from the command line.
 pub struct DatasetArgs<'a> {
@@ -41,7 +43,8 @@ pub struct DatasetArgs<'a> {
     pub model: Option<&'a Path>,
     /// Print a line per frame.
     pub details: bool,
-    /// With a bag as the dataset: the PointCloud2 topic (its clouds carry a `label` field).
+    /// With a bag as the dataset: the PointCloud2 topic (its clouds carry a `label` field; default:
+    /// the bag's one PointCloud2 topic).
     pub topic: Option<&'a str>,
 }
 
@@ -65,12 +68,22 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     if args.max_frames == Some(0) {
         bail!("--max-frames 0: allowed 1 or more");
     }
-    // Unknown methods and bad models are refused before any frame is read.
-    let model = args.model;
-    let make = |name: &str| super::common::method(name, 0, model.filter(|_| super::common::takes_model(name)));
-    for m in &args.methods {
-        make(m)?;
-    }
+    // Unknown methods and bad models are refused before any frame is read; each model file is
+    // read once, every instance (one per sequence) built from it.
+    let resolved: Vec<ResolvedMethod> = args
+        .methods
+        .iter()
+        .map(|m| {
+            let model = args.model.filter(|_| classifier::takes_model(m));
+            classifier::registry::resolve(m, &MethodOptions { seed: 0, model })
+        })
+        .collect::<Result<_, _>>()?;
+    let make = |name: &str| -> classifier::Result<Box<dyn classifier::GroundClassifier + Send>> {
+        match resolved.iter().find(|r| r.name() == name) {
+            Some(r) => r.build(),
+            None => classifier::method_by_name(name, 0),
+        }
+    };
     if sim::io::ros2::is_bag(args.dir) {
         return run_bag(args, &protocol, &make);
     }
@@ -78,7 +91,7 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
         bail!("--topic applies to a bag (an .mcap file or a rosbag2 directory); `{}` is none", args.dir.display());
     }
     let layout = DatasetLayout::open(args.dir, args.sequences.as_deref())?;
-    let setup = super::classify::sensor_setup(args.rig, args.calibration)?;
+    let setup = recording::sensor_setup(args.rig, args.calibration)?;
     // A dataset of ours, without --rig: each sequence ordered with its own rig and mount.
     let sequence_setups = match (args.rig, args.calibration) {
         (None, None) => super::dataset::manifest_setups(args.dir)?,
@@ -110,9 +123,8 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
         protocol: &protocol,
         max_frames_per_sequence: args.max_frames,
     };
-    let factory = |name: &str| make(name).map_err(|e| classifier::ClassifyError::Ordering(format!("{e:#}")));
     let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
-    let scores = evaluate(&layout, &args.methods, &factory, &options, |view: &FrameView<'_>| {
+    let scores = evaluate(&layout, &args.methods, &make, &options, |view: &FrameView<'_>| {
         if args.details {
             let c = &view.score.scores.0;
             println!(
@@ -147,22 +159,24 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `eval --dataset BAG --topic TOPIC`: every PointCloud2 message of the topic read as `classify`
-/// reads it, scored per return of its grid against its own `label` field (SemanticKITTI ids, as our
-/// layouts and most labelled conversions carry them) under the protocol; the vegetation rule of
-/// `patchwork` uses the height in the message's frame.
+/// `eval --dataset BAG [--topic TOPIC]`: every PointCloud2 message of the topic (default: the bag's
+/// one PointCloud2 topic) read as `classify` reads it, scored per return of its grid against its
+/// own `label` field (SemanticKITTI ids, as our layouts and most labelled conversions carry them)
+/// under the protocol; the vegetation rule of `patchwork` uses the height in the message's frame.
+/// A bag cut short is scored up to its last whole message, with a warning (printed, and in the
+/// JSON's `warnings`).
 fn run_bag(
     args: &DatasetArgs<'_>,
     protocol: &Protocol,
-    make: &dyn Fn(&str) -> anyhow::Result<Box<dyn classifier::GroundClassifier + Send>>,
+    make: &dyn Fn(&str) -> classifier::Result<Box<dyn classifier::GroundClassifier + Send>>,
 ) -> anyhow::Result<()> {
     use classifier::dataset::FrameScore;
-    let bag = sim::io::ros2::Bag::open(args.dir)?;
-    let Some(topic) = args.topic else { bail!("{}", super::classify_bag::topics_message(&bag)?) };
+    let recording = Recording::open(args.dir, args.topic)?;
+    let topic = recording.topic().unwrap_or_default();
     if args.out.is_some() {
         bail!("--out (outcome pictures) applies to SemanticKITTI-layout datasets, not to bags");
     }
-    let setup = super::classify::sensor_setup(args.rig, args.calibration)?;
+    let setup = recording::sensor_setup(args.rig, args.calibration)?;
     let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
     let mut methods = Vec::new();
     for m in &args.methods {
@@ -170,82 +184,68 @@ fn run_bag(
     }
     let mut scores: Vec<MethodScore> =
         args.methods.iter().map(|m| MethodScore { method: m.clone(), frames: Vec::new() }).collect();
-    let mut reader = super::classify::FrameReader::default();
-    let (mut skipped, mut fatal) = (0usize, None::<anyhow::Error>);
+    let mut skipped = 0usize;
     let take = args.max_frames.unwrap_or(usize::MAX);
-    bag.for_each_cloud(topic, |m| {
-        if m.index >= take {
-            return Ok(());
+    let mut frames = recording.frames(Ordering::Ordered(&setup))?;
+    while let Some(frame) = frames.next_frame() {
+        let frame = match frame {
+            Ok(f) => f,
+            // Messages come in index order: past the last one asked for, the reading stops.
+            Err(e) if e.message_index().is_some_and(|i| i >= take) => break,
+            Err(e) if e.is_message() => {
+                eprintln!("{e}; skipped");
+                skipped += 1;
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        if frame.index >= take {
+            break;
         }
-        let step = (|| -> anyhow::Result<bool> {
-            let file = args.dir.display();
-            let Ok(pc) = m.decode().map_err(|e| eprintln!("`{file}` {topic} message {}: {e}; skipped", m.index)) else {
-                return Ok(false);
-            };
-            if !pc.fields.iter().any(|f| f.name == "label") {
-                bail!("`{}` {topic} message {}: no `label` field: scoring needs labels", args.dir.display(), m.index);
-            }
-            let Ok(pcd) = sim::io::ros2::pointcloud2::to_pcd(&pc, m.groundtruth_comment.as_deref())
-                .map_err(|e| eprintln!("`{file}` {topic} message {}: {e}; skipped", m.index))
-            else {
-                return Ok(false);
-            };
-            let name = std::path::PathBuf::from(format!("{}#{topic}[{}]", args.dir.display(), m.index));
-            if let Err(e) = reader.read_pcd_bytes(&name, &pcd, &setup) {
-                eprintln!("`{file}` {topic} message {}: {e:#}; skipped", m.index);
-                return Ok(false);
-            }
-            let cloud = reader.cloud();
-            for (method, score) in methods.iter_mut().zip(scores.iter_mut()) {
-                let t = std::time::Instant::now();
-                let ground =
-                    method.classify(&classifier::FrameInput { index: m.index, cloud, world_from_vehicle: None })?;
-                let mut fs = FrameScore {
-                    sequence: topic.to_string(),
-                    frame: format!("{:06}", m.index),
-                    classify_ms: t.elapsed().as_secs_f64() * 1e3,
-                    ..FrameScore::default()
-                };
-                for (i, &g) in ground.iter().enumerate() {
-                    let p = cloud.point_in_vehicle[i];
-                    if !p.is_finite() || p == glam::Vec3::ZERO {
-                        fs.no_returns += u64::from(cloud.has_return(i));
-                        continue;
-                    }
-                    let q = sensor_from_vehicle.transform_point3(p);
-                    fs.add(protocol.truth(cloud.label[i].0, q.z), g, q.length());
-                }
-                if args.details {
-                    let c = &fs.scores.0;
-                    println!(
-                        "  {:<12} {topic}[{}]  P {:.4} R {:.4} F1 {:.4}",
-                        score.method,
-                        m.index,
-                        c.precision(),
-                        c.recall(),
-                        c.f1()
-                    );
-                }
-                score.frames.push(fs);
-            }
-            Ok(true)
-        })();
-        match step {
-            Ok(true) => {}
-            Ok(false) => skipped += 1,
-            Err(e) => {
-                fatal = Some(e);
-                return Err(sim::SimError::invalid("message", m.index, "a labelled message"));
-            }
+        let labelled =
+            frame.message.and_then(|m| m.decode().ok()).is_some_and(|pc| pc.fields.iter().any(|f| f.name == "label"));
+        if !labelled {
+            bail!("`{}` {topic} message {}: no `label` field: scoring needs labels", args.dir.display(), frame.index);
         }
-        Ok(())
-    })
-    .map_err(|e| fatal.take().unwrap_or_else(|| e.into()))?;
-    if let Some(e) = fatal {
-        return Err(e);
+        let cloud = frame.cloud;
+        for (method, score) in methods.iter_mut().zip(scores.iter_mut()) {
+            let t = std::time::Instant::now();
+            let ground =
+                method.classify(&classifier::FrameInput { index: frame.index, cloud, world_from_vehicle: None })?;
+            let mut fs = FrameScore {
+                sequence: topic.to_string(),
+                frame: format!("{:06}", frame.index),
+                classify_ms: t.elapsed().as_secs_f64() * 1e3,
+                ..FrameScore::default()
+            };
+            for (i, &g) in ground.iter().enumerate() {
+                let p = cloud.point_in_vehicle[i];
+                if !p.is_finite() || p == glam::Vec3::ZERO {
+                    fs.no_returns += u64::from(cloud.has_return(i));
+                    continue;
+                }
+                let q = sensor_from_vehicle.transform_point3(p);
+                fs.add(protocol.truth(cloud.label[i].0, q.z), g, q.length());
+            }
+            if args.details {
+                let c = &fs.scores.0;
+                println!(
+                    "  {:<12} {topic}[{}]  P {:.4} R {:.4} F1 {:.4}",
+                    score.method,
+                    frame.index,
+                    c.precision(),
+                    c.recall(),
+                    c.f1()
+                );
+            }
+            score.frames.push(fs);
+        }
     }
     if scores.first().is_none_or(|s| s.frames.is_empty()) {
         bail!("no message of `{topic}` in `{}` could be scored ({skipped} skipped)", args.dir.display());
+    }
+    for w in frames.warnings() {
+        println!("{w}");
     }
     println!(
         "bag {} topic {topic}: {} message(s) scored, {skipped} skipped; protocol {}",
@@ -255,7 +255,10 @@ fn run_bag(
     );
     print_table(&scores);
     if let Some(path) = args.json {
-        let doc = report(args.dir, protocol, args.rig, args.calibration, &scores);
+        let mut doc = report(args.dir, protocol, args.rig, args.calibration, &scores);
+        if !frames.warnings().is_empty() {
+            doc["warnings"] = serde_json::json!(frames.warnings());
+        }
         sim::io::atomic::write_bytes_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())?;
         println!("scores written to {}", path.display());
     }

@@ -180,7 +180,7 @@ fn from_dataset(
                     dir.display()
                 );
             };
-            let setup = super::classify::sensor_setup(Some(rig), None)?;
+            let setup = classifier::recording::sensor_setup(Some(rig), None)?;
             layout.sequences.iter().map(|s| (s.id.clone(), setup.clone())).collect()
         }
     };

@@ -61,14 +61,14 @@ pub(super) struct FieldPos {
 }
 
 #[derive(PartialEq, Eq)]
-pub(super) enum DataKind {
+pub(crate) enum DataKind {
     Ascii,
     Binary,
     /// LZF-compressed, field-major (PCL's `binary_compressed`).
     Compressed,
 }
 
-pub(super) struct Header {
+pub(crate) struct Header {
     pub(super) slots: [Option<FieldPos>; SLOTS],
     pub(super) width: usize,
     pub(super) height: usize,
@@ -105,11 +105,8 @@ pub(super) fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
         let Some(key) = words.first() else { continue };
         let rest = &words[1..];
         if key.starts_with('#') {
-            if words.get(1) == Some(&"groundtruth") {
-                let get = |k: &str| words.iter().find_map(|w| w.strip_prefix(k).and_then(|v| v.parse::<usize>().ok()));
-                if let (Some(r), Some(p)) = (get("rows="), get("planes=")) {
-                    grid = Some((r, p));
-                }
+            if let Some(g) = grid_of_comment(line) {
+                grid = Some(g);
             }
             continue;
         }
@@ -178,22 +175,72 @@ pub(super) fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
         return Err(bad(format!("PCD header: POINTS {points} but WIDTH {width} x HEIGHT {height} = {declared}")));
     }
     let data = data.ok_or_else(|| bad("PCD header: no DATA".into()))?;
+    let fields: Vec<FieldDecl> = fields
+        .into_iter()
+        .zip(types)
+        .zip(sizes)
+        .zip(counts)
+        .map(|(((name, letter), size), count)| FieldDecl { name, letter, size, count })
+        .collect();
+    layout(path, &fields, width, height, points, data, data_start, grid)
+}
+
+/// One field as a PCD header declares it (or a PointCloud2's `PointField` does): name, type letter
+/// (`F`, `U`, `I`), size in bytes and count.
+#[derive(Clone, Debug)]
+pub(crate) struct FieldDecl {
+    pub(crate) name: String,
+    pub(crate) letter: char,
+    pub(crate) size: usize,
+    pub(crate) count: usize,
+}
+
+/// `(rows, planes)` of our own layout's `# groundtruth rows=R planes=P` comment line, if `line` is
+/// one.
+pub(crate) fn grid_of_comment(line: &str) -> Option<(usize, usize)> {
+    let words: Vec<&str> = line.split_whitespace().collect();
+    if words.first().is_none_or(|w| !w.starts_with('#')) || words.get(1) != Some(&"groundtruth") {
+        return None;
+    }
+    let get = |k: &str| words.iter().find_map(|w| w.strip_prefix(k).and_then(|v| v.parse::<usize>().ok()));
+    match (get("rows="), get("planes=")) {
+        (Some(r), Some(p)) => Some((r, p)),
+        _ => None,
+    }
+}
+
+/// The header of records laid out as `fields` say, in that order (`points` of them, `width x
+/// height` declared): where each field the reader understands lies in a record, checked (types
+/// and sizes the reader decodes, `x y z` present). The one place a record layout is decided, for
+/// PCD files and PointCloud2 messages alike.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn layout(
+    path: &Path,
+    fields: &[FieldDecl],
+    width: usize,
+    height: usize,
+    points: usize,
+    data: DataKind,
+    data_start: usize,
+    grid: Option<(usize, usize)>,
+) -> Result<Header> {
+    let bad = |m: String| SimError::bad_file(path, m);
     let mut slots = [None; SLOTS];
     let (mut offset, mut token) = (0usize, 0usize);
     let mut field_spans = Vec::with_capacity(fields.len());
-    for k in 0..fields.len() {
-        let scalar = match (types[k], sizes[k]) {
-            ('F', 4 | 8) => Scalar::F(sizes[k]),
-            ('U', 1 | 2 | 4 | 8) => Scalar::U(sizes[k]),
-            ('I', 1 | 2 | 4 | 8) => Scalar::I(sizes[k]),
-            (t, s) => return Err(bad(format!("PCD header: field `{}` has unsupported TYPE {t} SIZE {s}", fields[k]))),
+    for f in fields {
+        let scalar = match (f.letter, f.size) {
+            ('F', 4 | 8) => Scalar::F(f.size),
+            ('U', 1 | 2 | 4 | 8) => Scalar::U(f.size),
+            ('I', 1 | 2 | 4 | 8) => Scalar::I(f.size),
+            (t, s) => return Err(bad(format!("PCD header: field `{}` has unsupported TYPE {t} SIZE {s}", f.name))),
         };
-        if let Some(slot) = slot_of(&fields[k]) {
+        if let Some(slot) = slot_of(&f.name) {
             slots[slot as usize].get_or_insert(FieldPos { scalar, offset, token });
         }
-        field_spans.push((offset, sizes[k] * counts[k]));
-        offset += sizes[k] * counts[k];
-        token += counts[k];
+        field_spans.push((offset, f.size * f.count));
+        offset += f.size * f.count;
+        token += f.count;
     }
     for (slot, name) in [(Slot::X, "x"), (Slot::Y, "y"), (Slot::Z, "z")] {
         if slots[slot as usize].is_none() {

@@ -34,6 +34,7 @@ mod layouts;
 mod reader;
 mod writer;
 
+pub(crate) use header::{DataKind, FieldDecl, grid_of_comment, layout};
 pub use layouts::{PcdLayout, encode_layout, write_layout};
 pub use reader::{PcdFrame, PcdInfo, read, read_bytes, read_bytes_into, read_bytes_with_info, read_with_info};
 pub use writer::{RECORD_BYTES, encode, write};

@@ -95,7 +95,8 @@ pub struct PcdFrame<'a> {
 enum Data<'a> {
     /// Binary records in the file's bytes.
     Binary(&'a [u8]),
-    /// Binary records decompressed from `binary_compressed` data.
+    /// Binary records decompressed from `binary_compressed` data (or gathered from a message's
+    /// padded rows).
     Decompressed(Vec<u8>),
     /// ASCII values, `tokens` a point.
     Ascii(Vec<f64>),
@@ -133,6 +134,18 @@ impl<'a> PcdFrame<'a> {
                 }
                 Data::Ascii(parse_ascii(&lines, h.tokens, &needed, bad)?)
             }
+        };
+        Ok(PcdFrame { path, h, data })
+    }
+
+    /// A frame of binary records laid out as `header` says, in `body` (borrowed, or owned where
+    /// the records had to be gathered first): a PointCloud2 message taken as it lies
+    /// ([`crate::io::ros2::pointcloud2::frame`]). `body` must hold `header.points` records.
+    pub(crate) fn from_records(path: &'a Path, h: Header, body: std::borrow::Cow<'a, [u8]>) -> Result<Self> {
+        check_binary_size(path, &h, body.len())?;
+        let data = match body {
+            std::borrow::Cow::Borrowed(b) => Data::Binary(b),
+            std::borrow::Cow::Owned(v) => Data::Decompressed(v),
         };
         Ok(PcdFrame { path, h, data })
     }

@@ -425,7 +425,8 @@ impl Bag {
         Ok(map)
     }
 
-    /// The bag's topics with their types and message counts (every message is read).
+    /// The bag's topics with their types and message counts (from the summary, else every message
+    /// is read; a file cut short counts its messages up to the cut).
     pub fn topics(&self) -> Result<Vec<TopicInfo>> {
         // The summary sections list channels and counts without reading the messages; files
         // without one (a writer that skipped it) are read through.
@@ -436,7 +437,12 @@ impl Bag {
         for file in &self.files {
             let bytes = Self::read(file)?;
             for m in Messages::new(&bytes) {
-                let m = m.map_err(|e| bag_error(file, format!("corrupt or truncated MCAP: {e}")))?;
+                let m = match m {
+                    Ok(m) => m,
+                    // A file cut short: its topics as far as it goes (the reading says where).
+                    Err(e) if e.truncated => break,
+                    Err(e) => return Err(bag_error(file, format!("corrupt MCAP: {e}"))),
+                };
                 let ty = m.channel.schema.clone();
                 topics
                     .entry(m.channel.topic.clone())
@@ -501,12 +507,14 @@ impl Bag {
         )
     }
 
-    /// Calls `each` with every message of `topic`, in the order they were written (file by
-    /// file). Refused, naming the topics there are: a topic that is not in the bag, or not
-    /// PointCloud2 in `cdr` (ROS 1, JSON, ...). A corrupt or truncated file stops the reading with
-    /// an error naming the file and the message index reached. The MCAP is read and its chunks
-    /// decompressed on a thread of its own, a message or two ahead of `each`.
-    pub fn for_each_cloud(&self, topic: &str, mut each: impl FnMut(BagCloud) -> Result<()>) -> Result<usize> {
+    /// The messages of `topic`, in the order they were written (file by file), read and their
+    /// chunks decompressed on a thread of their own, a message or two ahead of the caller.
+    /// Refused, naming the topics there are: a topic that is not in the bag, or not PointCloud2
+    /// in `cdr` (ROS 1, JSON, ...). A file that is corrupt stops the reading with an error naming
+    /// the file and the message index reached; a file cut short (a recorder killed mid-write) is
+    /// read up to its last whole message and the cut is reported by [`BagClouds::truncations`],
+    /// as `mcap recover` would read it.
+    pub fn clouds(&self, topic: &str) -> Result<BagClouds> {
         if let Some(topics) = self.summary_topics() {
             match topics.iter().find(|t| t.name == topic) {
                 None => return Err(self.no_such_topic(topic)),
@@ -516,57 +524,183 @@ impl Bag {
                 Some(_) => {}
             }
         }
-        let files = &self.files;
-        let count = std::thread::scope(|scope| -> Result<usize> {
-            let (sender, receiver) = std::sync::mpsc::sync_channel::<Result<BagCloud>>(2);
-            scope.spawn(move || {
-                let mut index = 0usize;
-                let result = (|| -> Result<()> {
-                    for file in files {
-                        let bytes = Self::read(file)?;
-                        for m in Messages::new(&bytes) {
-                            let m = m.map_err(|e| {
-                                bag_error(
-                                    file,
-                                    format!("corrupt or truncated MCAP after message {index} of `{topic}`: {e}"),
-                                )
-                            })?;
-                            if m.channel.topic != topic {
-                                continue;
-                            }
-                            let ty = m.channel.schema.as_str();
-                            if ty != POINTCLOUD2 || m.channel.message_encoding != "cdr" {
-                                return Err(Self::wrong_type(file, topic, ty, &m.channel.message_encoding));
-                            }
-                            let cloud = BagCloud {
-                                index,
-                                log_time_ns: m.log_time_ns,
-                                cdr: m.data.into_owned(),
-                                groundtruth_comment: m.channel.metadata.get(GROUNDTRUTH_KEY).cloned(),
-                            };
-                            if sender.send(Ok(cloud)).is_err() {
-                                return Ok(()); // the reader stopped
-                            }
-                            index += 1;
-                        }
+        let (sender, receiver) = std::sync::mpsc::sync_channel::<Event>(2);
+        let (files, wanted) = (self.files.clone(), topic.to_string());
+        let handle = std::thread::spawn(move || {
+            let mut index = 0usize;
+            for file in &files {
+                let bytes = match Self::read(file) {
+                    Ok(b) => b,
+                    Err(e) => {
+                        let _ = sender.send(Event::Failed(e));
+                        return;
                     }
-                    Ok(())
-                })();
-                if let Err(e) = result {
-                    let _ = sender.send(Err(e));
+                };
+                let mut last_log_time_ns = None;
+                for m in Messages::new(&bytes) {
+                    let m = match m {
+                        Ok(m) => m,
+                        Err(e) if e.truncated => {
+                            let cut =
+                                Truncation { file: file.clone(), messages: index, last_log_time_ns, reason: e.message };
+                            if sender.send(Event::Truncated(cut)).is_err() {
+                                return;
+                            }
+                            break;
+                        }
+                        Err(e) => {
+                            let message = format!("corrupt MCAP after message {index} of `{wanted}`: {e}");
+                            let _ = sender.send(Event::Failed(bag_error(file, message)));
+                            return;
+                        }
+                    };
+                    if m.channel.topic != wanted {
+                        continue;
+                    }
+                    let ty = m.channel.schema.as_str();
+                    if ty != POINTCLOUD2 || m.channel.message_encoding != "cdr" {
+                        let _ = sender.send(Event::Failed(Self::wrong_type(
+                            file,
+                            &wanted,
+                            ty,
+                            &m.channel.message_encoding,
+                        )));
+                        return;
+                    }
+                    last_log_time_ns = Some(m.log_time_ns);
+                    let cloud = BagCloud {
+                        index,
+                        log_time_ns: m.log_time_ns,
+                        cdr: m.data.into_owned(),
+                        groundtruth_comment: m.channel.metadata.get(GROUNDTRUTH_KEY).cloned(),
+                    };
+                    if sender.send(Event::Cloud(cloud)).is_err() {
+                        return; // the reader stopped
+                    }
+                    index += 1;
                 }
-            });
-            let mut count = 0usize;
-            for cloud in receiver {
-                each(cloud?)?;
-                count += 1;
             }
-            Ok(count)
-        })?;
-        if count == 0 {
-            return Err(self.no_such_topic(topic));
+        });
+        Ok(BagClouds {
+            bag: Bag { path: self.path.clone(), files: self.files.clone() },
+            topic: topic.to_string(),
+            receiver: Some(receiver),
+            handle: Some(handle),
+            truncations: Vec::new(),
+            read: 0,
+            done: false,
+        })
+    }
+}
+
+/// What the reading thread of [`Bag::clouds`] sends.
+enum Event {
+    Cloud(BagCloud),
+    Truncated(Truncation),
+    Failed(SimError),
+}
+
+/// A bag file cut short: where its reading stopped.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Truncation {
+    /// The file.
+    pub file: PathBuf,
+    /// Messages of the topic read before the cut (over the bag's files so far): the last one read
+    /// is `messages - 1`.
+    pub messages: usize,
+    /// Log time of the last message of the topic read in this file, nanoseconds.
+    pub last_log_time_ns: Option<u64>,
+    /// What the MCAP reader said at the cut.
+    pub reason: String,
+}
+
+impl std::fmt::Display for Truncation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.messages.checked_sub(1) {
+            Some(last) => write!(
+                f,
+                "`{}` is cut short ({}): read up to its last whole message, message {last}{} ({} read)",
+                self.file.display(),
+                self.reason,
+                self.last_log_time_ns.map_or(String::new(), |t| format!(" (log time {t} ns)")),
+                self.messages
+            ),
+            None => {
+                write!(f, "`{}` is cut short ({}) before any message of the topic", self.file.display(), self.reason)
+            }
         }
-        Ok(count)
+    }
+}
+
+/// The messages of one topic of a bag ([`Bag::clouds`]), each `Ok` or the error that ended the
+/// reading; a topic with no message at all (or none before a cut) ends in an error naming the
+/// bag's PointCloud2 topics.
+pub struct BagClouds {
+    bag: Bag,
+    topic: String,
+    receiver: Option<std::sync::mpsc::Receiver<Event>>,
+    handle: Option<std::thread::JoinHandle<()>>,
+    truncations: Vec<Truncation>,
+    read: usize,
+    done: bool,
+}
+
+impl BagClouds {
+    /// The files found cut short so far (each read up to its last whole message).
+    pub fn truncations(&self) -> &[Truncation] {
+        &self.truncations
+    }
+
+    /// The topic read.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+}
+
+impl Iterator for BagClouds {
+    type Item = Result<BagCloud>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        loop {
+            let event = self.receiver.as_ref().and_then(|r| r.recv().ok());
+            match event {
+                Some(Event::Cloud(c)) => {
+                    self.read += 1;
+                    return Some(Ok(c));
+                }
+                Some(Event::Truncated(t)) => self.truncations.push(t),
+                Some(Event::Failed(e)) => {
+                    self.done = true;
+                    return Some(Err(e));
+                }
+                None => {
+                    self.done = true;
+                    if self.read > 0 {
+                        return None;
+                    }
+                    let error = self.bag.no_such_topic(&self.topic);
+                    return Some(Err(match self.truncations.first() {
+                        None => error,
+                        Some(cut) => {
+                            bag_error(&self.bag.path, format!("no whole message of `{}`: {cut}; {error}", self.topic))
+                        }
+                    }));
+                }
+            }
+        }
+    }
+}
+
+impl Drop for BagClouds {
+    fn drop(&mut self) {
+        // Closing the channel stops the reading thread at its next message.
+        self.receiver = None;
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
     }
 }
 
@@ -611,25 +745,36 @@ mod tests {
         let topics = b.topics().unwrap();
         assert_eq!(topics.len(), 2);
         assert_eq!(b.pointcloud_topics().unwrap()[0].count, 3);
-        let mut z = Vec::new();
-        let n = b
-            .for_each_cloud("/lidar/points", |c| {
-                let pc = c.decode().map_err(|e| SimError::invalid("cloud", e, "a PointCloud2"))?;
-                z.push(f32::from_le_bytes(pc.data[8..12].try_into().unwrap()));
-                Ok(())
+        let z: Vec<f32> = b
+            .clouds("/lidar/points")
+            .unwrap()
+            .map(|c| {
+                let c = c.unwrap();
+                let pc = c.decode().unwrap();
+                f32::from_le_bytes(pc.data[8..12].try_into().unwrap())
             })
-            .unwrap();
-        assert_eq!((n, z), (3, vec![3.0, 4.0, 5.0]));
-        let e = b.for_each_cloud("/nope", |_| Ok(())).unwrap_err().to_string();
+            .collect();
+        assert_eq!(z, vec![3.0, 4.0, 5.0]);
+        let e = b.clouds("/nope").err().unwrap().to_string();
         assert!(e.contains("/lidar/points (3 messages)"), "{e}");
-        let e = b.for_each_cloud("/tf_static", |_| Ok(())).unwrap_err().to_string();
+        let e = b.clouds("/tf_static").err().unwrap().to_string();
         assert!(e.contains("tf2_msgs/msg/TFMessage"), "{e}");
-        // A truncated file is refused naming it.
+        // A file cut short is read up to its last whole message, the cut reported naming the file
+        // and the last message read.
         let file = bag.join("scan_0.mcap");
         let bytes = std::fs::read(&file).unwrap();
-        std::fs::write(&file, &bytes[..bytes.len() / 2]).unwrap();
-        let e = Bag::open(&bag).unwrap().for_each_cloud("/lidar/points", |_| Ok(())).unwrap_err().to_string();
-        assert!(e.contains("scan_0.mcap"), "{e}");
+        std::fs::write(&file, &bytes[..bytes.len() - 30]).unwrap();
+        let b = Bag::open(&bag).unwrap();
+        let mut clouds = b.clouds("/lidar/points").unwrap();
+        assert_eq!(clouds.by_ref().map(|c| c.unwrap().index).collect::<Vec<_>>(), [0, 1, 2]);
+        let cut = clouds.truncations().to_vec();
+        assert_eq!(cut.len(), 1);
+        let text = cut[0].to_string();
+        assert!(text.contains("scan_0.mcap") && text.contains("message 2"), "{text}");
+        // Cut before any message: an error naming the file and the cut.
+        std::fs::write(&file, &bytes[..40]).unwrap();
+        let e = Bag::open(&bag).unwrap().clouds("/lidar/points").unwrap().find_map(|c| c.err()).unwrap().to_string();
+        assert!(e.contains("scan_0.mcap") && e.contains("cut short"), "{e}");
         // An unfinished bag leaves nothing.
         let w = BagWriter::create(&dir.path().join("never")).unwrap();
         drop(w);
@@ -661,12 +806,11 @@ mod tests {
         drop(w);
         let b = Bag::open(&path).unwrap();
         assert_eq!(b.pointcloud_topics().unwrap()[0].count, 4);
-        let mut z = Vec::new();
-        b.for_each_cloud("/points", |c| {
-            z.push(f32::from_le_bytes(c.decode().unwrap().data[8..12].try_into().unwrap()));
-            Ok(())
-        })
-        .unwrap();
+        let z: Vec<f32> = b
+            .clouds("/points")
+            .unwrap()
+            .map(|c| f32::from_le_bytes(c.unwrap().decode().unwrap().data[8..12].try_into().unwrap()))
+            .collect();
         assert_eq!(z, [3.0, 4.0, 5.0, 6.0]);
         let sqlite = dir.path().join("sqlite");
         std::fs::create_dir(&sqlite).unwrap();

@@ -9,5 +9,5 @@ pub mod pointcloud2;
 pub mod scan;
 pub mod stream;
 
-pub use bag::{Bag, BagCloud, BagCompression, BagWriter, TopicInfo, is_bag};
+pub use bag::{Bag, BagCloud, BagClouds, BagCompression, BagWriter, TopicInfo, Truncation, is_bag};
 pub use messages::PointCloud2;

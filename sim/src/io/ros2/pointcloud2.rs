@@ -2,14 +2,15 @@
 //!
 //! A PointCloud2 is a PCD file's binary body with the header as a message: our writers' PCD bytes
 //! ([`crate::io::pcd::encode_layout`]: our layout or a driver's) become a message by turning the
-//! header's fields into `PointField`s, and a message becomes PCD bytes for the readers by the
-//! reverse, with `_` padding fields where its fields leave gaps (as PCL writes them) and its rows'
-//! padding dropped. So a bag's clouds take exactly the path a PCD file takes into `classify`, and
-//! the same cloud gives the same decisions whichever way it comes.
+//! header's fields into `PointField`s ([`from_pcd`]), and a message is read by the PCD reader's
+//! decoder straight from its data, its fields making the record layout a PCD header would
+//! ([`frame`]: the one PointCloud2 decoder). So a bag's clouds take exactly the path a PCD file
+//! takes into `classify`, and the same cloud gives the same decisions whichever way it comes.
 
 use std::borrow::Cow;
 
 use super::messages::{Header, PointCloud2, PointField, datatype};
+use crate::io::pcd::{DataKind, FieldDecl, PcdFrame, grid_of_comment, layout};
 
 /// What is wrong with a PointCloud2 (the message, not the bag).
 pub type CloudError = String;
@@ -96,13 +97,20 @@ pub fn groundtruth_comment(pcd: &[u8]) -> Option<String> {
     pcd_parts(pcd).ok().and_then(|p| p.comment)
 }
 
-/// The PCD bytes of a PointCloud2 for the PCD readers: a header listing its fields in offset order
-/// (a `_` padding field of `U1 x n` where `n` bytes lie between two fields or after the last), then
-/// its rows without their padding. `comment` (our layout's `# groundtruth` line) goes into the
-/// header. Refused, with what is wrong: big-endian data, an unknown datatype, overlapping fields or
+/// A PointCloud2 as the PCD reader's frame, decoded from where its data lies (no PCD bytes in
+/// between): its fields in offset order make the record layout (gaps between fields, and after
+/// the last, skipped), rows without padding are read in place (padded rows are gathered once).
+/// `comment` (our layout's `# groundtruth` line, from the channel's metadata) restores our
+/// multi-echo grids; `path` names the message in errors. So a bag's clouds take exactly the path a
+/// PCD file takes into `classify`, and the same cloud gives the same decisions whichever way it
+/// comes. Refused, with what is wrong: big-endian data, an unknown datatype, overlapping fields or
 /// fields beyond `point_step`, a `row_step` shorter than a row, data of the wrong length, no
 /// `x`, `y` and `z` of a float type.
-pub fn to_pcd(cloud: &PointCloud2<'_>, comment: Option<&str>) -> Result<Vec<u8>, CloudError> {
+pub fn frame<'a>(
+    path: &'a std::path::Path,
+    cloud: &'a PointCloud2<'_>,
+    comment: Option<&str>,
+) -> Result<PcdFrame<'a>, CloudError> {
     if cloud.is_bigendian {
         return Err("big-endian data (is_bigendian): not read".into());
     }
@@ -130,20 +138,14 @@ pub fn to_pcd(cloud: &PointCloud2<'_>, comment: Option<&str>) -> Result<Vec<u8>,
             return Err(format!("no float field `{axis}`"));
         }
     }
-    let (mut names, mut sizes, mut types, mut counts) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut at = 0usize;
-    let pad = |gap: usize,
-               names: &mut Vec<String>,
-               sizes: &mut Vec<usize>,
-               types: &mut Vec<char>,
-               counts: &mut Vec<usize>| {
+    // The record layout: each field where it lies, a byte-wide padding field over every gap.
+    let mut decls = Vec::with_capacity(fields.len() + 1);
+    let pad = |gap: usize, decls: &mut Vec<FieldDecl>| {
         if gap > 0 {
-            names.push("_".to_string());
-            sizes.push(1);
-            types.push('U');
-            counts.push(gap);
+            decls.push(FieldDecl { name: "_".to_string(), letter: 'U', size: 1, count: gap });
         }
     };
+    let mut at = 0usize;
     for f in &fields {
         let (size, letter) = datatype::size_and_letter(f.datatype)
             .ok_or_else(|| format!("field `{}`: datatype {}", f.name, f.datatype))?;
@@ -155,34 +157,24 @@ pub fn to_pcd(cloud: &PointCloud2<'_>, comment: Option<&str>) -> Result<Vec<u8>,
         if end > step {
             return Err(format!("field `{}` ends at byte {end}, beyond point_step {step}", f.name));
         }
-        pad(offset - at, &mut names, &mut sizes, &mut types, &mut counts);
-        names.push(f.name.clone());
-        sizes.push(size as usize);
-        types.push(letter);
-        counts.push(count);
+        pad(offset - at, &mut decls);
+        decls.push(FieldDecl { name: f.name.clone(), letter, size: size as usize, count });
         at = end;
     }
-    pad(step - at, &mut names, &mut sizes, &mut types, &mut counts);
-    let join = |v: Vec<String>| v.join(" ");
-    let mut out = format!(
-        "# .PCD v0.7 - Point Cloud Data file format\n{}VERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {}\nDATA binary\n",
-        comment.map_or(String::new(), |c| format!("{c}\n")),
-        names.join(" "),
-        join(sizes.iter().map(usize::to_string).collect()),
-        join(types.iter().map(char::to_string).collect()),
-        join(counts.iter().map(usize::to_string).collect()),
-        width * height
-    )
-    .into_bytes();
-    out.reserve(row_bytes * height);
-    if cloud.row_step as usize == row_bytes {
-        out.extend_from_slice(&cloud.data);
+    pad(step - at, &mut decls);
+    let grid = comment.and_then(grid_of_comment);
+    let header =
+        layout(path, &decls, width, height, width * height, DataKind::Binary, 0, grid).map_err(|e| e.to_string())?;
+    let body = if cloud.row_step as usize == row_bytes {
+        Cow::Borrowed(&cloud.data[..])
     } else {
+        let mut rows = Vec::with_capacity(row_bytes * height);
         for row in cloud.data.chunks_exact(cloud.row_step as usize) {
-            out.extend_from_slice(&row[..row_bytes]);
+            rows.extend_from_slice(&row[..row_bytes]);
         }
-    }
-    Ok(out)
+        Cow::Owned(rows)
+    };
+    PcdFrame::from_records(path, header, body).map_err(|e| e.to_string())
 }
 
 /// The cloud with one more field, `ground` (`uint8`, 1 = ground), appended to every point: the
@@ -247,11 +239,16 @@ mod tests {
             let msg = from_pcd(&pcd, Header::default()).unwrap();
             assert_eq!((msg.height, msg.width), (2, 3), "{layout:?}");
             assert_eq!(msg.data.len(), 6 * msg.point_step as usize);
-            let back = to_pcd(&msg, groundtruth_comment(&pcd).as_deref()).unwrap();
-            let (a, b) = (
-                crate::io::pcd::read_bytes(std::path::Path::new("a.pcd"), &pcd).unwrap(),
-                crate::io::pcd::read_bytes(std::path::Path::new("b.pcd"), &back).unwrap(),
+            let name = std::path::Path::new("b#/points[0]");
+            let decoded = frame(name, &msg, groundtruth_comment(&pcd).as_deref()).unwrap();
+            let (a, mut b) = (
+                crate::io::pcd::read_bytes_with_info(std::path::Path::new("a.pcd"), &pcd).unwrap(),
+                crate::OrderedCloud::default(),
             );
+            let info = decoded.read_into(&mut b, None, glam::Affine3A::IDENTITY).unwrap();
+            assert_eq!(info, a.1, "{layout:?}");
+            let a = a.0;
+            assert_eq!((a.rows, a.cols, a.planes), (b.rows, b.cols, b.planes), "{layout:?}");
             assert!(
                 a.point_in_vehicle.iter().zip(&b.point_in_vehicle).all(|(p, q)| p == q || (p.is_nan() && q.is_nan())),
                 "{layout:?}"
@@ -290,16 +287,13 @@ mod tests {
             data: Cow::Owned(data),
             is_dense: true,
         };
-        let pcd = to_pcd(&msg, None).unwrap();
-        let text = String::from_utf8_lossy(&pcd[..pcd.len() - 40]).to_string();
-        assert!(
-            text.contains("FIELDS x y z _ ring _\nSIZE 4 4 4 1 2 1\nTYPE F F F U U U\nCOUNT 1 1 1 4 1 2"),
-            "{text}"
-        );
-        let c = crate::io::pcd::read_bytes(std::path::Path::new("m.pcd"), &pcd).unwrap();
+        let name = std::path::Path::new("m#/points[0]");
+        let mut c = crate::OrderedCloud::default();
+        frame(name, &msg, None).unwrap().read_into(&mut c, None, glam::Affine3A::IDENTITY).unwrap();
         assert_eq!(c.ring, vec![7, 8]);
+        assert_eq!(c.point_in_vehicle, vec![glam::Vec3::new(1.0, 2.0, 3.0); 2]);
         let bad = |m: PointCloud2<'_>, needle: &str| {
-            let e = to_pcd(&m, None).unwrap_err();
+            let e = frame(name, &m, None).err().expect("refused");
             assert!(e.contains(needle), "{e}");
         };
         bad(PointCloud2 { row_step: 50, ..msg.clone() }, "data bytes");

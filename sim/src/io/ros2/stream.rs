@@ -4,6 +4,10 @@
 //! `mcap::MessageStream` (0.26) reads chunk records without such a bound: a corrupted length in a
 //! damaged file makes it reserve exabytes and abort the process. Here every record (and so every
 //! allocation) is limited to [`MAX_RECORD_BYTES`], and a larger one is refused as corrupt.
+//!
+//! The reader is linear (no summary or footer needed), so a file cut short (a recorder killed
+//! mid-write) yields every message that was written whole, then a [`StreamError`] that says it
+//! was cut short ([`StreamError::truncated`]), as `mcap recover` reads such a file.
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -27,6 +31,33 @@ pub struct ChannelInfo {
     pub message_encoding: String,
     /// Its metadata.
     pub metadata: std::collections::BTreeMap<String, String>,
+}
+
+/// Why the stream stopped before its end.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StreamError {
+    /// The file ends inside a record (cut short), rather than holding bytes that are not MCAP.
+    pub truncated: bool,
+    /// What the reader said.
+    pub message: String,
+}
+
+impl StreamError {
+    fn corrupt(message: impl Into<String>) -> Self {
+        Self { truncated: false, message: message.into() }
+    }
+}
+
+impl From<mcap::McapError> for StreamError {
+    fn from(e: mcap::McapError) -> Self {
+        Self { truncated: matches!(e, mcap::McapError::UnexpectedEof), message: e.to_string() }
+    }
+}
+
+impl std::fmt::Display for StreamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
 }
 
 /// A message of the stream.
@@ -61,7 +92,7 @@ impl<'a> Messages<'a> {
         }
     }
 
-    fn next_record(&mut self) -> Option<Result<Record<'a>, String>> {
+    fn next_record(&mut self) -> Option<Result<Record<'a>, StreamError>> {
         while let Some(event) = self.reader.next_event() {
             match event {
                 Ok(LinearReadEvent::ReadRequest(need)) => {
@@ -71,9 +102,9 @@ impl<'a> Messages<'a> {
                     self.buf = &self.buf[n..];
                 }
                 Ok(LinearReadEvent::Record { data, opcode }) => {
-                    return Some(mcap::parse_record(opcode, data).map(Record::into_owned).map_err(|e| e.to_string()));
+                    return Some(mcap::parse_record(opcode, data).map(Record::into_owned).map_err(StreamError::from));
                 }
-                Err(e) => return Some(Err(e.to_string())),
+                Err(e) => return Some(Err(e.into())),
             }
         }
         None
@@ -81,7 +112,7 @@ impl<'a> Messages<'a> {
 }
 
 impl<'a> Iterator for Messages<'a> {
-    type Item = Result<StreamMessage<'a>, String>;
+    type Item = Result<StreamMessage<'a>, StreamError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.done {
@@ -111,10 +142,10 @@ impl<'a> Iterator for Messages<'a> {
                             Some(name) => name.clone(),
                             None => {
                                 self.done = true;
-                                return Some(Err(format!(
+                                return Some(Err(StreamError::corrupt(format!(
                                     "channel {} names schema {}, which is not there",
                                     c.id, c.schema_id
-                                )));
+                                ))));
                             }
                         }
                     };
@@ -129,7 +160,10 @@ impl<'a> Iterator for Messages<'a> {
                 Record::Message { header, data } => {
                     let Some(channel) = self.channels.get(&header.channel_id) else {
                         self.done = true;
-                        return Some(Err(format!("a message on channel {}, which is not there", header.channel_id)));
+                        return Some(Err(StreamError::corrupt(format!(
+                            "a message on channel {}, which is not there",
+                            header.channel_id
+                        ))));
                     };
                     return Some(Ok(StreamMessage { channel: channel.clone(), log_time_ns: header.log_time, data }));
                 }

@@ -1,6 +1,6 @@
 //! Input frames as bytes, read into one page-aligned buffer reused from file to file.
 //!
-//! `classify` and `bench classify` decode each frame straight from its file's bytes. Where those
+//! The reader ([`super::FrameReader`]) decodes each frame straight from its file's bytes. Where those
 //! bytes land matters more than how they are fetched: the kernel copies a file out of the page
 //! cache about four times as fast into a destination aligned to the cache line as into one at a
 //! 16-byte offset, which is where `malloc` puts a large `Vec<u8>`'s data. Measured on this

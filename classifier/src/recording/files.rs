@@ -1,0 +1,230 @@
+//! The file formats read as frames: one reader ([`FrameReader`]) for every layout
+//! ([`InputLayout`]), ordered for classification with a [`SensorSetup`] or read as stored.
+//!
+//! - PCD: a driver's organized cloud (no `# groundtruth` line, one plane) has its rows put in
+//!   elevation order as it is decoded ([`crate::ordering::organized`]); our own layout (or several
+//!   echo planes) is taken as it is; an unorganized cloud is ordered as a KITTI file is, or from its
+//!   `ring` field.
+//! - KITTI `.bin` (and its `.label`): ordered where the file's bytes lie, by scan unfolding or the
+//!   beam table ([`SensorSetup::order_kitti`]).
+//! - PLY, LAS: ordered from their points as an unorganized cloud is (their `ring` where they have
+//!   one).
+//! - A bag's PointCloud2 message: decoded by the PCD reader straight from the message's data
+//!   ([`sim::io::ros2::pointcloud2::frame`]) and ordered as a PCD file is.
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::Affine3A;
+use sim::OrderedCloud;
+use sim::io::pcd::PcdFrame;
+use sim::io::ros2::BagCloud;
+
+use super::bytes::InputBytes;
+use super::{InputLayout, Provenance, RecordingError};
+use crate::ordering::{CloudBuffer, OrderingReport, PointAttributes, SensorSetup, read_organized_into};
+
+/// Reads and orders frames one after another, keeping its buffers (the file's bytes, its points,
+/// the cloud and the ordering report) from frame to frame: a sequence of frames of one sensor
+/// allocates nothing after the first (measured: a fresh 128 x 2,048 cloud cost more than its
+/// filling, in page faults).
+#[derive(Default)]
+pub struct FrameReader {
+    /// The file's bytes.
+    bytes: InputBytes,
+    /// A KITTI `.label`'s bytes.
+    label_bytes: InputBytes,
+    /// A KITTI file's records.
+    flat: sim::io::kitti::KittiPoints,
+    /// A PCD as the file holds it (ordered from here where it is not organized).
+    file_cloud: OrderedCloud,
+    /// The cloud to classify.
+    cloud: CloudBuffer,
+    /// What ordering did, for input from other tools.
+    report: OrderingReport,
+    /// Whether `report` belongs to the last frame (input from other tools).
+    ordered: bool,
+}
+
+impl FrameReader {
+    /// The last frame's cloud.
+    pub fn cloud(&self) -> &OrderedCloud {
+        self.cloud.cloud()
+    }
+
+    /// What ordering did with the last frame, for input from other tools (cell of every input
+    /// point); `None` for our own files and for frames read as stored.
+    pub fn report(&self) -> Option<&OrderingReport> {
+        self.ordered.then_some(&self.report)
+    }
+
+    /// Takes `cloud` as the last frame's, unordered (a frame read as stored).
+    pub(crate) fn set_cloud(&mut self, cloud: OrderedCloud) {
+        *self.cloud.cloud_mut() = cloud;
+        self.ordered = false;
+    }
+
+    /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
+    /// ordering; for a driver's organized PCD, decoded in order, only the file's read and the header).
+    pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> Result<f64, RecordingError> {
+        let t0 = Instant::now();
+        self.ordered = false;
+        let ordering = |error| RecordingError::Ordering { what: format!("`{}`", path.display()), error };
+        match InputLayout::of_file(path)? {
+            InputLayout::Pcd => {
+                let FrameReader { bytes, file_cloud, cloud, report, ordered, .. } = self;
+                let bytes = bytes.load(path)?;
+                let frame = PcdFrame::parse(path, bytes)?;
+                let (read_ms, from_another_tool) = order_pcd(path, &frame, setup, file_cloud, cloud, report, t0)?;
+                *ordered = from_another_tool;
+                Ok(read_ms)
+            }
+            InputLayout::KittiBin => {
+                let label = path.with_extension("label");
+                let bytes = self.bytes.load(path)?;
+                let label_bytes = match label.is_file() {
+                    true => Some((label.as_path(), self.label_bytes.load(&label)?)),
+                    false => None,
+                };
+                // The records are ordered where the file's bytes lie (no decoding copy) where
+                // they can be; the points are decoded otherwise.
+                let records = sim::io::kitti::records_or_points_into(path, bytes, label_bytes, &mut self.flat)?;
+                let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+                let flat = &self.flat;
+                let labels = flat.labels.as_deref();
+                let ordered = match records {
+                    // Scan-ordered, shuffled or organized (an Ouster image with zero no-returns).
+                    Some(records) => setup.order_kitti(records, labels, &mut self.cloud, &mut self.report),
+                    None => {
+                        let records: Vec<[f32; 4]> =
+                            flat.points.iter().zip(&flat.intensity).map(|(p, &i)| [p.x, p.y, p.z, i]).collect();
+                        setup.order_kitti(&records, labels, &mut self.cloud, &mut self.report)
+                    }
+                };
+                ordered.map_err(ordering)?;
+                self.ordered = true;
+                Ok(read_ms)
+            }
+            layout @ (InputLayout::Ply | InputLayout::Las) => {
+                let (c, has_ring) = match layout {
+                    InputLayout::Ply => sim::io::ply::read_with_ring(path)?,
+                    _ => (sim::io::las::read(path)?, false),
+                };
+                let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+                order_flat_cloud(path, &c, has_ring, setup, &mut self.cloud, &mut self.report)?;
+                self.ordered = true;
+                Ok(read_ms)
+            }
+            InputLayout::PointCloud2 => Err(RecordingError::Unsupported { path: path.to_path_buf() }),
+        }
+    }
+
+    /// Reads a bag's PointCloud2 message (`provenance` names it in errors) straight from its data
+    /// and orders it as [`FrameReader::read`] orders a `.pcd` file (with `setup`), or keeps it as
+    /// stored (`None`: the message's own grid and point order, as the PCD of the same cloud is
+    /// read). Returns the milliseconds of the decode (the CDR and the header; the rest is
+    /// ordering). A message that cannot be read is a [`RecordingError::Message`].
+    pub fn read_message(
+        &mut self,
+        provenance: &Provenance,
+        message: &BagCloud,
+        setup: Option<&SensorSetup>,
+    ) -> Result<f64, RecordingError> {
+        let t0 = Instant::now();
+        self.ordered = false;
+        let bad = |reason: String| RecordingError::Message {
+            bag: provenance.file.clone(),
+            topic: provenance.topic.clone().unwrap_or_default(),
+            index: message.index,
+            reason,
+        };
+        let name = provenance.name();
+        let name = name.as_path();
+        let cloud = message.decode().map_err(bad)?;
+        let frame =
+            sim::io::ros2::pointcloud2::frame(name, &cloud, message.groundtruth_comment.as_deref()).map_err(bad)?;
+        let Some(setup) = setup else {
+            frame.read_into(self.cloud.cloud_mut(), None, Affine3A::IDENTITY).map_err(|e| bad(e.to_string()))?;
+            return Ok(t0.elapsed().as_secs_f64() * 1e3);
+        };
+        let FrameReader { file_cloud, cloud, report, .. } = self;
+        let (read_ms, ordered) =
+            order_pcd(name, &frame, setup, file_cloud, cloud, report, t0).map_err(|e| bad(e.to_string()))?;
+        self.ordered = ordered;
+        Ok(read_ms)
+    }
+}
+
+/// Reads `path` as the file holds it, unordered: an organized PCD keeps its grid (`HEIGHT x WIDTH`,
+/// its rows in the file's order), every other file is a `1 x N` grid in file order (a KITTI `.bin`
+/// with its `.label` where there is one).
+pub fn read_as_stored(path: &Path) -> Result<OrderedCloud, RecordingError> {
+    Ok(match InputLayout::of_file(path)? {
+        InputLayout::Pcd => sim::io::pcd::read(path)?,
+        InputLayout::Ply => sim::io::ply::read(path)?,
+        InputLayout::Las => sim::io::las::read(path)?,
+        InputLayout::KittiBin => {
+            let label = path.with_extension("label");
+            sim::io::kitti::read(path, label.is_file().then_some(label.as_path()))?
+        }
+        InputLayout::PointCloud2 => return Err(RecordingError::Unsupported { path: path.to_path_buf() }),
+    })
+}
+
+/// Orders an unorganized cloud `c` read from `path` (its points, intensity, labels, times, and its
+/// rings where `has_ring`) into `cloud`.
+fn order_flat_cloud(
+    path: &Path,
+    c: &OrderedCloud,
+    has_ring: bool,
+    setup: &SensorSetup,
+    cloud: &mut CloudBuffer,
+    report: &mut OrderingReport,
+) -> Result<(), RecordingError> {
+    let labels = c.label.iter().any(|l| l.0 != 0).then_some(c.label.as_slice());
+    let rings = has_ring.then_some(c.ring.as_slice());
+    let attributes = PointAttributes { intensity: Some(&c.intensity), labels, time_s: Some(&c.time_s), rings };
+    setup
+        .order_flat(&c.point_in_vehicle, &attributes, cloud, report)
+        .map_err(|error| RecordingError::Ordering { what: format!("`{}`", path.display()), error })
+}
+
+/// Orders a parsed PCD `frame` into `cloud`: a driver's organized cloud has its rows put in order
+/// as it is decoded; our own layout (or several echo planes) is taken as it is; an unorganized
+/// cloud is ordered as a KITTI file is, or from its `ring` field. Returns the milliseconds of the
+/// read (since `t0`) and whether the cloud came from another tool (then `report` holds what
+/// ordering did).
+#[allow(clippy::too_many_arguments)]
+fn order_pcd(
+    path: &Path,
+    frame: &PcdFrame<'_>,
+    setup: &SensorSetup,
+    file_cloud: &mut OrderedCloud,
+    cloud: &mut CloudBuffer,
+    report: &mut OrderingReport,
+    t0: Instant,
+) -> Result<(f64, bool), RecordingError> {
+    let (info, (rows, _, planes)) = (frame.info(), frame.shape());
+    if info.organized && !info.ours && planes == 1 {
+        // A driver's organized cloud: its rows are put in order as it is decoded, so `read_ms` is
+        // the file's read and the header, the rest counts as ordering.
+        let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+        if let Some(lasers) = setup.calibrated_lasers
+            && lasers != rows
+        {
+            return Err(RecordingError::CalibrationRows { name: path.display().to_string(), rows, lasers });
+        }
+        read_organized_into(frame, setup.vehicle_from_sensor, cloud.cloud_mut(), report)
+            .map_err(|error| RecordingError::Ordering { what: format!("the rows of `{}`", path.display()), error })?;
+        return Ok((read_ms, true));
+    }
+    let info = frame.read_into(file_cloud, None, Affine3A::IDENTITY)?;
+    let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+    if info.ours || file_cloud.planes > 1 {
+        std::mem::swap(cloud.cloud_mut(), file_cloud);
+        return Ok((read_ms, false));
+    }
+    // An unorganized PCD: ordered as a KITTI file is.
+    order_flat_cloud(path, file_cloud, info.has_ring, setup, cloud, report)?;
+    Ok((read_ms, true))
+}

@@ -1,0 +1,56 @@
+//! Where a frame came from: its file, and for a bag's message its topic, index and log time; the
+//! layout its points were read in. With the ordering report ([`crate::ordering::OrderingReport`])
+//! it says how a frame was read.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use super::InputLayout;
+
+/// Where a frame came from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Provenance {
+    /// The file (for a bag: the bag given, an `.mcap` file or a rosbag2 directory).
+    pub file: PathBuf,
+    /// How its points were laid out.
+    pub layout: InputLayout,
+    /// The bag's topic, for a message.
+    pub topic: Option<String>,
+    /// The message's index among the topic's messages (0 on), for a message.
+    pub message: Option<usize>,
+    /// The message's log time, nanoseconds, for a message.
+    pub log_time_ns: Option<u64>,
+}
+
+impl Provenance {
+    /// A file's.
+    pub fn file(file: PathBuf, layout: InputLayout) -> Self {
+        Self { file, layout, topic: None, message: None, log_time_ns: None }
+    }
+
+    /// A bag message's.
+    pub fn message(bag: PathBuf, topic: &str, index: usize, log_time_ns: u64) -> Self {
+        Self {
+            file: bag,
+            layout: InputLayout::PointCloud2,
+            topic: Some(topic.to_string()),
+            message: Some(index),
+            log_time_ns: Some(log_time_ns),
+        }
+    }
+
+    /// The name the frame goes by in messages: the file, or `BAG#TOPIC[INDEX]` for a message.
+    pub fn name(&self) -> PathBuf {
+        match (&self.topic, self.message) {
+            (Some(topic), Some(index)) => PathBuf::from(format!("{}#{topic}[{index}]", self.file.display())),
+            _ => self.file.clone(),
+        }
+    }
+}
+
+impl std::fmt::Display for Provenance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.name().display())
+    }
+}
