@@ -184,13 +184,22 @@ def scan(
     mount: Optional[Mapping[str, Union[float, int]]] = None,
     seed: int = 0,
     frames: int = 1,
-    speed: float = 0.0,
+    speed_m_per_s: float = 0.0,
+    yaw_rate_deg_per_s: float = 0.0,
+    waypoints_m: Optional[Sequence[tuple[float, float]]] = None,
     ideal: bool = False,
+    noise_scale: Optional[float] = None,
+    dropout: Optional[float] = None,
+    intensity_scale: Optional[float] = None,
     weather: Optional[str] = None,
+    speed: Optional[float] = None,
 ) -> list[Frame]:
-    """Scan ``scene`` (bundled name, family, ``.toml`` path or TOML text) with ``rig`` (preset,
-    ``.toml`` path or TOML text). ``params``: family parameters; ``mount``: ``x_m y_m z_m roll_deg
-    pitch_deg yaw_deg`` (and ``sensor``); ``ideal``: exact ranges; ``weather``:
+    """Scan ``scene`` (bundled name, built-in such as ``flat-objects``, family, ``.toml`` path or
+    TOML text) with ``rig`` (preset, ``.toml`` path or TOML text). The keywords are a scan spec's
+    fields (docs/scan-spec.md) with its ranges and messages. ``params``: family parameters;
+    ``mount``: ``x_m y_m z_m roll_deg pitch_deg yaw_deg``, ``sensor`` (index, name or ``"rig"``) and
+    ``mode`` (``"absolute"``/``"relative"``); ``speed`` is the deprecated spelling of
+    ``speed_m_per_s``; ``ideal``: exact ranges; ``weather``:
     ``"fog:visibility_m=50"``, ``"rain:rate_mm_h=10"``, ``"snow:rate_mm_h=2"`` or ``"clear"``
     (returns from the medium get labels 150 fog, 151 rain, 152 snow). Deterministic."""
 

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use groundtruth_scenario::{MountOverride, ParamValue, Scenario};
+use groundtruth_scenario::{MountMode, MountOverride, MountTarget, ParamValue, Scenario};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
 
@@ -15,8 +15,9 @@ fn is_toml_text(s: &str) -> bool {
     s.contains('\n') || s.contains('=')
 }
 
-/// The scene: TOML text, a `.toml` file (or any existing file), a bundled scene name, or a
-/// generator family name, in that order (bundled names first, as the command line resolves them).
+/// The scene: TOML text, a `.toml` file (or any existing file), a bundled scene name, a simulator
+/// built-in (`flat-objects`) or `fixture-terrain`, or a generator family name (bundled names
+/// first, as the command line resolves them).
 pub fn scene_scenario(scene: &str) -> PyResult<Scenario> {
     if is_toml_text(scene) {
         return Ok(Scenario::toml(scene));
@@ -24,7 +25,8 @@ pub fn scene_scenario(scene: &str) -> PyResult<Scenario> {
     if scene.ends_with(".toml") || Path::new(scene).is_file() {
         return Ok(Scenario::toml_file(scene));
     }
-    if scenes::bundled_names().contains(&scene) {
+    let builtin = sim::scene::builtin::NAMES.contains(&scene) || scene == groundtruth_scenario::spec::FIXTURE_TERRAIN;
+    if scenes::bundled_names().contains(&scene) || builtin {
         return Ok(Scenario::bundled(scene));
     }
     if scenes::families::NAMES.contains(&scene) {
@@ -33,8 +35,10 @@ pub fn scene_scenario(scene: &str) -> PyResult<Scenario> {
     Err(value_error(
         "scene",
         format!(
-            "unknown scene `{scene}`; known: {} (bundled), families {} (or a path to a .toml scene file, or TOML text)",
+            "unknown scene `{scene}`; known: {} (bundled), {}, {} (built-in), families {} (or a path to a .toml scene file, or TOML text)",
             scenes::bundled_names().join(", "),
+            sim::scene::builtin::NAMES.join(", "),
+            groundtruth_scenario::spec::FIXTURE_TERRAIN,
             scenes::families::NAMES.join(", ")
         ),
     ))
@@ -115,9 +119,10 @@ pub fn with_params(mut scenario: Scenario, params: &Bound<'_, PyDict>) -> PyResu
     Ok(scenario)
 }
 
-/// Mount overrides from a dict with keys `x_m y_m z_m roll_deg pitch_deg yaw_deg` (and `sensor`,
-/// the index of the sensor they apply to).
-pub fn with_mount(mut scenario: Scenario, mount: &Bound<'_, PyDict>) -> PyResult<Scenario> {
+/// The mount override from a dict with the keys of a scan spec's `mount`: `x_m y_m z_m roll_deg
+/// pitch_deg yaw_deg`, `sensor` (an index, a sensor name or `"rig"`) and `mode` (`"absolute"` or
+/// `"relative"`); an unknown key gets the spec's own message.
+pub fn with_mount(scenario: Scenario, mount: &Bound<'_, PyDict>) -> PyResult<Scenario> {
     let mut o = MountOverride::default();
     for (k, v) in mount.iter() {
         let Ok(name) = k.cast::<PyString>() else {
@@ -126,7 +131,24 @@ pub fn with_mount(mut scenario: Scenario, mount: &Bound<'_, PyDict>) -> PyResult
         let name = name.to_str()?;
         let field = format!("mount.{name}");
         if name == "sensor" {
-            scenario = scenario.sensor(uint(&v, &field, 0, 255)? as usize);
+            o.sensor = Some(match v.cast::<PyString>() {
+                Ok(s) => MountTarget::Name(s.to_str()?.to_string()),
+                Err(_) => MountTarget::Index(uint(&v, &field, 0, 255)? as usize),
+            });
+            continue;
+        }
+        if name == "mode" {
+            let Ok(mode) = v.cast::<PyString>() else {
+                return Err(type_error(
+                    &field,
+                    format!("expected \"absolute\" or \"relative\", got {}", type_name(&v)),
+                ));
+            };
+            o.mode = match mode.to_str()? {
+                "absolute" => MountMode::Absolute,
+                "relative" => MountMode::Relative,
+                other => return Err(value_error(&field, format!("`{other}` (allowed: absolute, relative)"))),
+            };
             continue;
         }
         let x = Some(finite_f64(&v, &field)? as f32);
@@ -137,12 +159,7 @@ pub fn with_mount(mut scenario: Scenario, mount: &Bound<'_, PyDict>) -> PyResult
             "roll_deg" => o.roll_deg = x,
             "pitch_deg" => o.pitch_deg = x,
             "yaw_deg" => o.yaw_deg = x,
-            _ => {
-                return Err(value_error(
-                    &field,
-                    "unknown field (allowed: x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg, sensor)",
-                ));
-            }
+            _ => return Err(value_error(&field, groundtruth_scenario::spec::mount_key_error(name))),
         }
     }
     o.validate().map_err(scenario_error)?;

@@ -19,89 +19,145 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::args::{finite_f64, scene_scenario, uint, with_mount, with_params, with_rig};
-use crate::error::{scenario_error, value_error};
+use crate::error::scenario_error;
 use crate::frame::Frame;
 
 /// The largest number of frames of one `scan` call.
 const MAX_FRAMES: u64 = sim::scan::MAX_FRAMES as u64;
 
-/// Builds the scenario of `scan()`'s arguments.
-#[allow(clippy::too_many_arguments)]
-fn scenario(
-    scene: &str,
-    rig: &str,
-    params: Option<&Bound<'_, PyDict>>,
-    mount: Option<&Bound<'_, PyDict>>,
-    seed: &Bound<'_, PyAny>,
-    frames: &Bound<'_, PyAny>,
-    speed: &Bound<'_, PyAny>,
+/// `scan()`'s keyword arguments beyond scene and rig.
+struct ScanKwargs<'py> {
+    params: Option<Bound<'py, PyDict>>,
+    mount: Option<Bound<'py, PyDict>>,
+    seed: Option<Bound<'py, PyAny>>,
+    frames: Option<Bound<'py, PyAny>>,
+    speed_m_per_s: Option<Bound<'py, PyAny>>,
+    yaw_rate_deg_per_s: Option<Bound<'py, PyAny>>,
+    waypoints_m: Option<Vec<(f64, f64)>>,
     ideal: bool,
-    weather: Option<&str>,
-) -> PyResult<groundtruth_scenario::Scenario> {
+    noise_scale: Option<Bound<'py, PyAny>>,
+    dropout: Option<Bound<'py, PyAny>>,
+    intensity_scale: Option<Bound<'py, PyAny>>,
+    weather: Option<String>,
+    speed: Option<Bound<'py, PyAny>>,
+    rest: Option<Bound<'py, PyDict>>,
+}
+
+/// Builds the scenario of `scan()`'s arguments: every value checked with its field named, the
+/// ranges by the scan spec (the same messages as a spec file, a dataset or sweep file, the command
+/// line and the Rust builder).
+fn scenario(py: Python<'_>, scene: &str, rig: &str, a: ScanKwargs<'_>) -> PyResult<groundtruth_scenario::Scenario> {
+    if let Some(rest) = &a.rest
+        && let Some((k, _)) = rest.iter().next()
+    {
+        let key: String = k.extract()?;
+        return Err(scenario_error(groundtruth_scenario::spec::key_error(&key, "scan()")));
+    }
     let mut s = with_rig(scene_scenario(scene)?, rig)?;
-    if let Some(p) = params {
+    if let Some(p) = &a.params {
         s = with_params(s, p)?;
     }
-    if let Some(m) = mount {
+    if let Some(m) = &a.mount {
         s = with_mount(s, m)?;
     }
-    let speed = finite_f64(speed, "speed")?;
-    if speed.abs() > 100.0 {
-        return Err(value_error("speed", format!("{speed} m/s is out of range (allowed: -100 ..= 100)")));
+    if let Some(v) = &a.speed {
+        PyErr::warn(
+            py,
+            py.get_type::<pyo3::exceptions::PyDeprecationWarning>().as_any(),
+            c"scan(speed=...) is deprecated: use speed_m_per_s (the same metres per second)",
+            1,
+        )?;
+        s = s.speed_m_per_s(finite_f64(v, "speed")? as f32);
     }
-    if let Some(spec) = weather {
+    if let Some(v) = &a.speed_m_per_s {
+        s = s.speed_m_per_s(finite_f64(v, "speed_m_per_s")? as f32);
+    }
+    if let Some(v) = &a.yaw_rate_deg_per_s {
+        s = s.yaw_rate_deg_per_s(finite_f64(v, "yaw_rate_deg_per_s")?);
+    }
+    if let Some(w) = a.waypoints_m {
+        s = s.waypoints_m(w.into_iter().map(|(x, y)| [x, y]).collect());
+    }
+    if let Some(v) = &a.noise_scale {
+        s = s.noise_scale(finite_f64(v, "noise_scale")?);
+    }
+    if let Some(v) = &a.dropout {
+        s = s.dropout(finite_f64(v, "dropout")?);
+    }
+    if let Some(v) = &a.intensity_scale {
+        s = s.intensity_scale(finite_f64(v, "intensity_scale")?);
+    }
+    if let Some(spec) = &a.weather {
         s = s.weather(sim::effects::weather::Weather::parse(spec).map_err(crate::error::sim_error)?);
     }
-    Ok(s.seed(uint(seed, "seed", 0, u64::MAX)?)
-        .frames(uint(frames, "frames", 1, MAX_FRAMES)? as usize)
-        .speed_m_per_s(speed as f32)
-        .ideal(ideal))
+    if let Some(v) = &a.seed {
+        s = s.seed(uint(v, "seed", 0, u64::MAX)?);
+    }
+    if let Some(v) = &a.frames {
+        s = s.frames(uint(v, "frames", 1, MAX_FRAMES)? as usize);
+    }
+    let s = s.ideal(a.ideal);
+    s.spec().validate().map_err(scenario_error)?;
+    Ok(s)
 }
 
 /// Scans a scene with a rig and returns the frames (a list of `Frame`).
 ///
-/// `scene`: a bundled scene (`groundtruth.SCENES`), a generator family (`groundtruth.FAMILIES`,
-/// with its default parameters), a path to a scene `.toml` file, or scene TOML text. `rig`: a preset
-/// (`groundtruth.RIGS`), a rig `.toml` path or rig TOML text. `params`: family parameters
-/// (`{"slope_deg": -12.0}`), range-checked. `mount`: overrides of the sensor's mount (`x_m y_m z_m
-/// roll_deg pitch_deg yaw_deg`, and `sensor` = which sensor, default 0). `seed`: the scene
-/// generator's and the scan's seed. `frames`: frame count; `speed`: ego speed, m/s. `ideal`: exact
-/// ranges, measurement effects off. `weather`: `"fog:visibility_m=50"`, `"rain:rate_mm_h=10"`,
-/// `"snow:rate_mm_h=2"` or `"clear"` (default: the scene file's `[weather]`, else none); returns
-/// from the medium are labelled fog (150), rain (151) or snow (152). Deterministic: the same arguments give the same arrays. The
-/// GIL is released while the scene is generated and scanned.
+/// `scene`: a bundled scene (`groundtruth.SCENES`), a simulator built-in (`flat-objects`) or
+/// `fixture-terrain`, a generator family (`groundtruth.FAMILIES`, with its default parameters), a
+/// path to a scene `.toml` file, or scene TOML text. `rig`: a preset (`groundtruth.RIGS`), a rig
+/// `.toml` path or rig TOML text. The keywords are a scan spec's fields (docs/scan-spec.md), with
+/// the same ranges and messages: `params` (family parameters, `{"slope_deg": -12.0}`), `mount`
+/// (`x_m y_m z_m roll_deg pitch_deg yaw_deg`, `sensor` = an index, a name or `"rig"`, `mode` =
+/// `"absolute"` or `"relative"`), `seed`, `frames`, `speed_m_per_s`, `yaw_rate_deg_per_s`,
+/// `waypoints_m` (`[(x, y), ...]`), `ideal` (exact ranges), `noise_scale`, `dropout`,
+/// `intensity_scale`, `weather` (`"fog:visibility_m=50"`, `"rain:rate_mm_h=10"`,
+/// `"snow:rate_mm_h=2"` or `"clear"`; default the scene file's `[weather]`; returns from the medium
+/// are labelled fog (150), rain (151) or snow (152)). `speed` is the deprecated spelling of
+/// `speed_m_per_s`; any other keyword is refused with the spec's message. Deterministic: the same
+/// arguments give the same arrays. The GIL is released while the scene is generated and scanned.
 #[pyfunction]
 #[pyo3(
-    signature = (scene, rig, *, params=None, mount=None, seed=None, frames=None, speed=None, ideal=false, weather=None),
-    text_signature = "(scene, rig, *, params=None, mount=None, seed=0, frames=1, speed=0.0, ideal=False, weather=None)"
+    signature = (scene, rig, *, params=None, mount=None, seed=None, frames=None, speed_m_per_s=None, yaw_rate_deg_per_s=None, waypoints_m=None, ideal=false, noise_scale=None, dropout=None, intensity_scale=None, weather=None, speed=None, **rest),
+    text_signature = "(scene, rig, *, params=None, mount=None, seed=0, frames=1, speed_m_per_s=0.0, yaw_rate_deg_per_s=0.0, waypoints_m=None, ideal=False, noise_scale=None, dropout=None, intensity_scale=None, weather=None)"
 )]
 #[allow(clippy::too_many_arguments)]
-fn scan(
-    py: Python<'_>,
+fn scan<'py>(
+    py: Python<'py>,
     scene: &str,
     rig: &str,
-    params: Option<&Bound<'_, PyDict>>,
-    mount: Option<&Bound<'_, PyDict>>,
-    seed: Option<&Bound<'_, PyAny>>,
-    frames: Option<&Bound<'_, PyAny>>,
-    speed: Option<&Bound<'_, PyAny>>,
+    params: Option<Bound<'py, PyDict>>,
+    mount: Option<Bound<'py, PyDict>>,
+    seed: Option<Bound<'py, PyAny>>,
+    frames: Option<Bound<'py, PyAny>>,
+    speed_m_per_s: Option<Bound<'py, PyAny>>,
+    yaw_rate_deg_per_s: Option<Bound<'py, PyAny>>,
+    waypoints_m: Option<Vec<(f64, f64)>>,
     ideal: bool,
-    weather: Option<&str>,
+    noise_scale: Option<Bound<'py, PyAny>>,
+    dropout: Option<Bound<'py, PyAny>>,
+    intensity_scale: Option<Bound<'py, PyAny>>,
+    weather: Option<String>,
+    speed: Option<Bound<'py, PyAny>>,
+    rest: Option<Bound<'py, PyDict>>,
 ) -> PyResult<Vec<Frame>> {
-    let zero = 0u64.into_pyobject(py)?.into_any();
-    let one = 1u64.into_pyobject(py)?.into_any();
-    let zero_f = 0.0f64.into_pyobject(py)?.into_any();
-    let s = scenario(
-        scene,
-        rig,
+    let kwargs = ScanKwargs {
         params,
         mount,
-        seed.unwrap_or(&zero),
-        frames.unwrap_or(&one),
-        speed.unwrap_or(&zero_f),
+        seed,
+        frames,
+        speed_m_per_s,
+        yaw_rate_deg_per_s,
+        waypoints_m,
         ideal,
+        noise_scale,
+        dropout,
+        intensity_scale,
         weather,
-    )?;
+        speed,
+        rest,
+    };
+    let s = scenario(py, scene, rig, kwargs)?;
     let scan = Arc::new(py.detach(move || s.scan()).map_err(scenario_error)?);
     Ok((0..scan.frames().len()).map(|k| Frame { scan: scan.clone(), k }).collect())
 }

@@ -24,7 +24,7 @@ import groundtruth as gt
         (dict(scene="ramp", rig="vlp16-roof", params={3: 1.0}), TypeError, "params"),
         (dict(scene="ramp", rig="vlp16-roof", params=[("slope_deg", 1.0)]), TypeError, "params"),
         (dict(scene="flat", rig="vlp16-roof", mount={"z_m": math.nan}), ValueError, "mount.z_m"),
-        (dict(scene="flat", rig="vlp16-roof", mount={"z_m": 100.0}), ValueError, "mount.z_m"),
+        (dict(scene="flat", rig="vlp16-roof", mount={"z_m": 150.0}), ValueError, "mount.z_m"),
         (dict(scene="flat", rig="vlp16-roof", mount={"z_m": "high"}), TypeError, "mount.z_m"),
         (dict(scene="flat", rig="vlp16-roof", mount={"height": 1.0}), ValueError, "mount.height"),
         (dict(scene="flat", rig="vlp16-roof", mount={"sensor": 3, "z_m": 1.0}), ValueError, "sensor"),
@@ -33,7 +33,8 @@ import groundtruth as gt
         (dict(scene="flat", rig="vlp16-roof", seed=1.5), TypeError, "seed"),
         (dict(scene="flat", rig="vlp16-roof", frames=0), ValueError, "frames"),
         (dict(scene="flat", rig="vlp16-roof", frames=True), TypeError, "frames"),
-        (dict(scene="flat", rig="vlp16-roof", speed=math.nan), ValueError, "speed"),
+        (dict(scene="flat", rig="vlp16-roof", speed_m_per_s=math.nan), ValueError, "speed_m_per_s"),
+        (dict(scene="flat", rig="vlp16-roof", speed_m_per_s=500.0), ValueError, "speed_m_per_s"),
         (dict(scene="flat", rig="vlp16-roof", speed=500.0), ValueError, "speed"),
         (dict(scene="flat", rig="vlp16-roof", speed="fast"), TypeError, "speed"),
         (dict(scene="version = 1\nfamily = 'nope'\n", rig="vlp16-roof"), ValueError, "nope"),
@@ -43,6 +44,35 @@ import groundtruth as gt
 def test_scan_bad_input(kwargs, exc, match):
     with pytest.raises(exc, match=match):
         gt.scan(**kwargs)
+
+
+# The scan spec's own messages: the same words `groundtruth scan --spec`, dataset and sweep files
+# and the Rust builder give (scenario/src/spec/tests.rs, tests/cli_spec.rs).
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [
+        (dict(colour=1), "unknown field `colour`, expected one of"),
+        (dict(yaw_rate=0.3), "invalid value for `yaw_rate`: a key without the unit every front end takes"),
+        (dict(mount={"z_m": 150.0}), r"invalid value for `mount.z_m`: 150 \(allowed: -100 ..= 100\)"),
+        (dict(mount={"height": 1.0}), "unknown field `height`"),
+        (dict(yaw_rate_deg_per_s=200.0), r"invalid value for `yaw_rate_deg_per_s`: 200 \(allowed: -114.59 ..= 114.59\)"),
+    ],
+)
+def test_scan_spec_messages(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        gt.scan("flat", "vlp16-roof", **kwargs)
+
+
+def test_speed_is_deprecated_but_works():
+    with pytest.warns(DeprecationWarning, match="speed_m_per_s"):
+        (old,) = gt.scan("flat", "vlp16-roof", speed=5.0, ideal=True)
+    (new,) = gt.scan("flat", "vlp16-roof", speed_m_per_s=5.0, ideal=True)
+    assert np.array_equal(old.range_m, new.range_m, equal_nan=True)
+
+
+def test_the_builtin_scene_is_reachable():
+    (f,) = gt.scan("flat-objects", "vlp16-roof", ideal=True)
+    assert f.returns > 1000
 
 
 @pytest.fixture(scope="module")

@@ -2,32 +2,13 @@
 //! (preset, file or value), mount overrides, ideal or measured ranges, seed, frames and speed; then
 //! [`Scenario::scan`].
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use sim::scan::{MAX_FRAMES, ScanConfig};
-
-use crate::error::{Result, ScenarioError};
-use crate::geometry::Geometry;
-use crate::mount_override::MountOverride;
+use crate::error::Result;
+use crate::mount_override::{MountOverride, MountTarget};
 use crate::param_value::ParamValue;
 use crate::scan::Scan;
-
-/// Where the scene comes from.
-#[derive(Clone, Debug)]
-enum SceneSource {
-    Family(String),
-    Bundled(String),
-    Toml { text: String, base_dir: PathBuf },
-    File(PathBuf),
-}
-
-/// Where the rig comes from.
-#[derive(Clone, Debug)]
-enum RigSource {
-    Preset(String),
-    File(PathBuf),
-    Value(sim::Rig),
-}
+use crate::spec::ScanSpec;
 
 /// A scenario to scan: what the scene is, which rig sees it and how.
 ///
@@ -50,35 +31,33 @@ enum RigSource {
 /// ```
 #[derive(Clone, Debug)]
 pub struct Scenario {
-    source: SceneSource,
-    params: Vec<(String, ParamValue)>,
-    rig: RigSource,
-    mount: MountOverride,
-    sensor: usize,
-    ideal: bool,
-    seed: u64,
-    frames: usize,
-    speed_m_per_s: f32,
-    yaw_rate_rad_per_s: f32,
-    /// `None`: the scene file's `[weather]`, if any.
-    weather: Option<sim::effects::weather::Weather>,
+    /// The description every setter writes into.
+    spec: ScanSpec,
+    /// A rig given as a value ([`Scenario::rig_value`]), in place of `spec.rig`.
+    rig_value: Option<sim::Rig>,
 }
 
 impl Scenario {
-    fn new(source: SceneSource) -> Self {
-        Self {
-            source,
-            params: Vec::new(),
-            rig: RigSource::Preset("vlp16-roof".into()),
-            mount: MountOverride::default(),
-            sensor: 0,
-            ideal: false,
-            seed: 0,
-            frames: 1,
-            speed_m_per_s: 0.0,
-            yaw_rate_rad_per_s: 0.0,
-            weather: None,
-        }
+    fn new(spec: ScanSpec) -> Self {
+        Self { spec, rig_value: None }
+    }
+
+    /// A scenario over a whole [`ScanSpec`] (checked at [`Scenario::scan`]); the setters below
+    /// change its fields.
+    ///
+    /// ```
+    /// use groundtruth_scenario::{Scenario, ScanSpec};
+    /// let spec = ScanSpec { scene: "flat-objects".into(), frames: 2, speed_m_per_s: 5.0, ..Default::default() };
+    /// assert_eq!(Scenario::from_spec(spec).scan()?.frames().len(), 2);
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn from_spec(spec: ScanSpec) -> Self {
+        Self { spec, rig_value: None }
+    }
+
+    /// The description of the scan this builder makes.
+    pub fn spec(&self) -> &ScanSpec {
+        &self.spec
     }
 
     /// A scene of generator `family` (`ramp`, `basin`, `elevated`, `hill`, `flat`, `city`, ...; see
@@ -90,11 +69,18 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn family(family: &str) -> Self {
-        Self::new(SceneSource::Family(family.to_string()))
+        Self::new(ScanSpec { scene: String::new(), family: Some(family.to_string()), ..ScanSpec::default() })
     }
 
-    /// A bundled scene by name (`ramp-up`, `basin`, `city`, ...; see `scenes::bundled_names`);
-    /// [`Scenario::param`] overrides its parameters.
+    /// A scene by name: a bundled scene (`ramp-up`, `basin`, `city`, ...; see
+    /// `scenes::bundled_names`), a simulator built-in (`flat-objects`) or `fixture-terrain`;
+    /// [`Scenario::param`] overrides a bundled scene's parameters.
+    ///
+    /// ```
+    /// let scan = groundtruth_scenario::Scenario::bundled("flat-objects").ideal(true).scan()?;
+    /// assert!(scan.frames()[0].cloud.returns() > 1000);
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
     ///
     /// ```
     /// let scan = groundtruth_scenario::Scenario::bundled("ramp-down").scan()?;
@@ -102,7 +88,7 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn bundled(name: &str) -> Self {
-        Self::new(SceneSource::Bundled(name.to_string()))
+        Self::new(ScanSpec { scene: name.to_string(), ..ScanSpec::default() })
     }
 
     /// A scene from TOML text (the scene file format of `scenes`); user meshes resolve against
@@ -115,7 +101,7 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn toml(text: &str) -> Self {
-        Self::new(SceneSource::Toml { text: text.to_string(), base_dir: PathBuf::from(".") })
+        Self::new(ScanSpec { scene: text.to_string(), ..ScanSpec::default() })
     }
 
     /// A scene from a TOML file; user meshes resolve against its directory.
@@ -125,7 +111,7 @@ impl Scenario {
     /// assert!(err.to_string().contains("no/such/scene.toml"));
     /// ```
     pub fn toml_file(path: impl AsRef<Path>) -> Self {
-        Self::new(SceneSource::File(path.as_ref().to_path_buf()))
+        Self::new(ScanSpec { scene: path.as_ref().display().to_string(), ..ScanSpec::default() })
     }
 
     /// Sets the family parameter `name` (a field of the family's `[params]`, e.g. `slope_deg`);
@@ -136,8 +122,7 @@ impl Scenario {
     /// assert!(err.to_string().contains("slope_deg"), "{err}");
     /// ```
     pub fn param(mut self, name: &str, value: impl Into<ParamValue>) -> Self {
-        self.params.retain(|(n, _)| n != name);
-        self.params.push((name.to_string(), value.into()));
+        self.spec.params.insert(name.to_string(), value.into());
         self
     }
 
@@ -150,11 +135,8 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn rig(mut self, name_or_path: &str) -> Self {
-        self.rig = if sim::rig::PRESETS.contains(&name_or_path) {
-            RigSource::Preset(name_or_path.to_string())
-        } else {
-            RigSource::File(PathBuf::from(name_or_path))
-        };
+        self.spec.rig = name_or_path.to_string();
+        self.rig_value = None;
         self
     }
 
@@ -167,23 +149,23 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn rig_value(mut self, rig: sim::Rig) -> Self {
-        self.rig = RigSource::Value(rig);
+        self.spec.rig.clone_from(&rig.name);
+        self.rig_value = Some(rig);
         self
     }
 
-    /// Which sensor of the rig the mount overrides apply to (default 0, the only one of the
-    /// single-sensor presets).
+    /// Which sensor of the rig the mount overrides apply to (default: the rig's only sensor; a rig
+    /// of several needs one named, or [`Scenario::mount`] with `sensor = "rig"` for the whole rig).
     ///
     /// ```
     /// let err = groundtruth_scenario::Scenario::family("flat").sensor(3).mount_z_m(2.0).scan().unwrap_err();
     /// assert!(err.to_string().contains("sensor"), "{err}");
     /// ```
-    pub fn sensor(mut self, index: usize) -> Self {
-        self.sensor = index;
-        self
+    pub fn sensor(self, index: usize) -> Self {
+        self.mount(MountOverride { sensor: Some(MountTarget::Index(index)), ..Default::default() })
     }
 
-    /// Replaces the set fields of the chosen sensor's mount.
+    /// Sets the fields `overrides` sets (values, and its target and mode when it names them).
     ///
     /// ```
     /// use groundtruth_scenario::{MountOverride, Scenario};
@@ -193,14 +175,7 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn mount(mut self, overrides: MountOverride) -> Self {
-        let o = overrides;
-        let m = &mut self.mount;
-        m.x_m = o.x_m.or(m.x_m);
-        m.y_m = o.y_m.or(m.y_m);
-        m.z_m = o.z_m.or(m.z_m);
-        m.roll_deg = o.roll_deg.or(m.roll_deg);
-        m.pitch_deg = o.pitch_deg.or(m.pitch_deg);
-        m.yaw_deg = o.yaw_deg.or(m.yaw_deg);
+        self.spec.mount.get_or_insert_with(MountOverride::default).merge(&overrides);
         self
     }
 
@@ -280,7 +255,7 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn ideal(mut self, ideal: bool) -> Self {
-        self.ideal = ideal;
+        self.spec.ideal = ideal;
         self
     }
 
@@ -296,7 +271,7 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn seed(mut self, seed: u64) -> Self {
-        self.seed = seed;
+        self.spec.seed = seed;
         self
     }
 
@@ -308,7 +283,7 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn frames(mut self, frames: usize) -> Self {
-        self.frames = frames;
+        self.spec.frames = frames as u64;
         self
     }
 
@@ -319,11 +294,26 @@ impl Scenario {
     /// assert!(err.to_string().contains("speed_m_per_s"), "{err}");
     /// ```
     pub fn speed_m_per_s(mut self, v: f32) -> Self {
-        self.speed_m_per_s = v;
+        self.spec.speed_m_per_s = f64::from(v);
         self
     }
 
-    /// Ego yaw rate, radians per second (-2 ..= 2, default 0).
+    /// Ego yaw rate, degrees per second (-114.59 ..= 114.59, i.e. 2 rad/s; default 0; + turns left).
+    ///
+    /// ```
+    /// let s = groundtruth_scenario::Scenario::family("flat").frames(2).speed_m_per_s(5.0).yaw_rate_deg_per_s(17.0).scan()?;
+    /// assert!(s.frames()[1].vehicle_pose.yaw_rad > 0.0);
+    /// let err = groundtruth_scenario::Scenario::family("flat").yaw_rate_deg_per_s(200.0).scan().unwrap_err();
+    /// assert!(err.to_string().contains("yaw_rate_deg_per_s"), "{err}");
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn yaw_rate_deg_per_s(mut self, v: f64) -> Self {
+        self.spec.yaw_rate_deg_per_s = v;
+        self
+    }
+
+    /// Ego yaw rate, radians per second: a convenience over [`Scenario::yaw_rate_deg_per_s`] (the
+    /// scan's yaw rate is exactly `v`).
     ///
     /// ```
     /// let s = groundtruth_scenario::Scenario::family("flat").frames(2).speed_m_per_s(5.0).yaw_rate_rad_per_s(0.3).scan()?;
@@ -331,7 +321,19 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn yaw_rate_rad_per_s(mut self, v: f32) -> Self {
-        self.yaw_rate_rad_per_s = v;
+        self.spec.set_yaw_rate_rad_per_s(v);
+        self
+    }
+
+    /// A path `[x, y]` (world frame, metres; 2 or more points) the ego follows at its speed (> 0).
+    ///
+    /// ```
+    /// let s = groundtruth_scenario::Scenario::family("flat").frames(2).speed_m_per_s(5.0).waypoints_m(vec![[0.0, 0.0], [10.0, 10.0]]).scan()?;
+    /// assert!(s.frames()[1].vehicle_pose.yaw_rad > 0.7);
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn waypoints_m(mut self, points: Vec<[f64; 2]>) -> Self {
+        self.spec.waypoints_m = Some(points);
         self
     }
 
@@ -351,80 +353,44 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn weather(mut self, weather: sim::effects::weather::Weather) -> Self {
-        self.weather = Some(weather);
+        self.spec.weather = Some(weather);
         self
     }
 
-    /// The scene's TOML text with the parameter overrides applied, and its base directory.
-    fn scene_text(&self) -> Result<(String, String, PathBuf)> {
-        let (text, name, base_dir) = match &self.source {
-            SceneSource::Family(f) => {
-                (format!("version = 1\nfamily = {}\n", toml::Value::String(f.clone())), f.clone(), PathBuf::from("."))
-            }
-            SceneSource::Bundled(n) => {
-                let t = scenes::bundled_text(n).ok_or_else(|| scenes::SceneError::UnknownScene {
-                    name: n.clone(),
-                    known: scenes::bundled_names().join(", "),
-                })?;
-                (t.to_string(), n.clone(), PathBuf::from("."))
-            }
-            SceneSource::Toml { text, base_dir } => (text.clone(), "scenario TOML".to_string(), base_dir.clone()),
-            SceneSource::File(p) => {
-                let t = std::fs::read_to_string(p).map_err(|source| ScenarioError::Io { path: p.clone(), source })?;
-                let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
-                (t, p.display().to_string(), dir)
-            }
-        };
-        if self.params.is_empty() {
-            return Ok((text, name, base_dir));
-        }
-        let mut doc: toml::Table = text.parse().map_err(|e: toml::de::Error| scenes::SceneError::Toml {
-            source_name: name.clone(),
-            message: e.to_string(),
-        })?;
-        let params = doc.entry("params").or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        let toml::Value::Table(params) = params else {
-            return Err(ScenarioError::invalid("params", "not a table", "a [params] table"));
-        };
-        for (k, v) in &self.params {
-            if let ParamValue::Float(f) = v
-                && !f.is_finite()
-            {
-                return Err(ScenarioError::invalid(format!("params.{k}"), f, "a finite number"));
-            }
-            params.insert(k.clone(), v.to_toml());
-        }
-        let text = toml::to_string(&doc).map_err(|e| ScenarioError::invalid("params", e, "TOML values"))?;
-        Ok((text, name, base_dir))
+    /// Range noise as a multiple of each sensor's own (`range_sigma_m`), 0 ..= 10.
+    ///
+    /// ```
+    /// let err = groundtruth_scenario::Scenario::family("flat").noise_scale(20.0).scan().unwrap_err();
+    /// assert_eq!(err.to_string(), "invalid value for `noise_scale`: 20 (allowed: 0 ..= 10)");
+    /// ```
+    pub fn noise_scale(mut self, scale: f64) -> Self {
+        self.spec.noise_scale = Some(scale);
+        self
     }
 
-    fn build_rig(&self) -> Result<sim::Rig> {
-        let mut rig = match &self.rig {
-            RigSource::Preset(n) => sim::Rig::preset(n)?,
-            RigSource::File(p) => {
-                let text =
-                    std::fs::read_to_string(p).map_err(|source| ScenarioError::Io { path: p.clone(), source })?;
-                let mut rig = sim::Rig::from_toml_str(&text, p)?;
-                if rig.name.is_empty() {
-                    rig.name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-                }
-                rig
-            }
-            RigSource::Value(r) => r.clone(),
-        };
-        self.mount.validate()?;
-        if self.mount != MountOverride::default() {
-            let n = rig.sensors.len();
-            let s = rig.sensors.get_mut(self.sensor).ok_or_else(|| {
-                ScenarioError::invalid(
-                    "sensor",
-                    self.sensor,
-                    format!("0 ..= {} (the rig's sensors)", n.saturating_sub(1)),
-                )
-            })?;
-            s.mount = self.mount.apply(s.mount);
-        }
-        Ok(rig)
+    /// Probability that a return is dropped at random, 0 ..= 0.9 (seeded by the scan's seed).
+    ///
+    /// ```
+    /// let all = groundtruth_scenario::Scenario::family("flat").scan()?.frames()[0].cloud.returns();
+    /// let some = groundtruth_scenario::Scenario::family("flat").dropout(0.5).scan()?.frames()[0].cloud.returns();
+    /// assert!(some < all * 6 / 10 && some > all * 4 / 10, "{some} of {all}");
+    /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
+    /// ```
+    pub fn dropout(mut self, probability: f64) -> Self {
+        self.spec.dropout = Some(probability);
+        self
+    }
+
+    /// Intensities multiplied by `scale` (clamped to 1), 0 ..= 10.
+    pub fn intensity_scale(mut self, scale: f64) -> Self {
+        self.spec.intensity_scale = Some(scale);
+        self
+    }
+
+    /// The ray casting backend (default `bvh`).
+    pub fn backend(mut self, backend: crate::spec::ScanBackend) -> Self {
+        self.spec.backend = Some(backend);
+        self
     }
 
     /// Generates the scene, builds the rig and scans every frame into labelled ordered clouds.
@@ -435,24 +401,17 @@ impl Scenario {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn scan(&self) -> Result<Scan> {
-        if self.frames == 0 || self.frames > MAX_FRAMES {
-            return Err(ScenarioError::invalid("frames", self.frames, format!("1 ..= {MAX_FRAMES}")));
-        }
-        let (text, name, base_dir) = self.scene_text()?;
-        let scene = scenes::load_str(&text, &name, &base_dir, self.seed)?;
-        let geometry = Geometry::parse(&scene.family, &text, &name)?;
-        let rig = self.build_rig()?;
-        let config = ScanConfig {
-            seed: self.seed,
-            frames: self.frames,
-            speed_m_per_s: self.speed_m_per_s,
-            yaw_rate_rad_per_s: self.yaw_rate_rad_per_s,
-            ideal: self.ideal,
-            ego_z_m: scene.ego_ground_z_m,
-            weather: self.weather.or(scene.weather),
-            ..ScanConfig::default()
+        self.spec.validate()?;
+        let scene = self.spec.load_scene()?;
+        let base = match &self.rig_value {
+            Some(r) => r.clone(),
+            None => crate::spec::load_rig(&self.spec.rig)?,
         };
-        let frames = sim::scan::scan(&scene.mesh, &rig, &config)?;
-        Ok(Scan::new(frames, scene.family, name, rig, geometry, self.seed))
+        let setup = self.spec.setup_with_rig(&scene, base)?;
+        let mut frames = sim::scan::scan(&scene.mesh, &setup.rig, &setup.config)?;
+        for f in &mut frames {
+            self.spec.vary(&mut f.cloud, f.index)?;
+        }
+        Ok(Scan::new(frames, scene.family, scene.name, setup.rig, scene.geometry, self.spec.seed))
     }
 }

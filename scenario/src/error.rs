@@ -25,6 +25,14 @@ pub enum ScenarioError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A scan spec that does not parse (an unknown field, a value of the wrong type).
+    #[error("{source_name}: {message}")]
+    Spec {
+        /// The file or front end it came from.
+        source_name: String,
+        /// What is wrong, as the parser says it (e.g. "unknown field `colour`, expected one of ...").
+        message: String,
+    },
     /// A builder setting outside its allowed range.
     #[error("invalid value for `{field}`: {value} (allowed: {allowed})")]
     Invalid {

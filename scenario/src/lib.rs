@@ -24,6 +24,9 @@
 //! # Ok::<(), groundtruth_scenario::ScenarioError>(())
 //! ```
 //!
+//! Every front end (this builder, the command line, dataset and sweep files, Python) describes a
+//! scan with one [`ScanSpec`], turned into the scanner's input by [`ScanSpec::setup`].
+//!
 //! Everything that takes user input returns [`ScenarioError`]; nothing panics on it. With the
 //! default feature `proptest`, [`strategies`] has proptest strategies for the hard cases (ramps,
 //! basins, raised plateaus vs flat roofs, hills, mounts, noise).
@@ -36,12 +39,13 @@ mod param_value;
 pub mod region;
 mod scan;
 pub mod score;
+pub mod spec;
 #[cfg(feature = "proptest")]
 pub mod strategies;
 
 pub use builder::Scenario;
 pub use error::{Result, ScenarioError};
-pub use mount_override::MountOverride;
+pub use mount_override::{MOUNT_LIMITS, MountMode, MountOverride, MountTarget};
 pub use param_value::ParamValue;
 pub use region::Region;
 pub use scan::{Decisions, Scan};
@@ -49,3 +53,4 @@ pub use score::RegionScore;
 /// The simulator crate, re-exported (clouds, rigs, classes).
 pub use sim;
 pub use sim::effects::weather::Weather;
+pub use spec::{LoadedScene, ScanBackend, ScanSetup, ScanSpec};

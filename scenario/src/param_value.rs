@@ -2,14 +2,16 @@
 
 /// A parameter value for [`Scenario::param`]: a number, an integer, a flag or a word, as in the
 /// `[params]` table of a scene file.
-#[derive(Clone, Debug, PartialEq)]
+/// In a [`crate::ScanSpec`] file it is the plain TOML or JSON value.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(untagged)]
 pub enum ParamValue {
-    /// A real number (most parameters: `slope_deg`, `depth_m`, ...).
-    Float(f64),
-    /// An integer (counts, e.g. `objects` of `flat`).
-    Int(i64),
     /// A flag.
     Bool(bool),
+    /// An integer (counts, e.g. `objects` of `flat`).
+    Int(i64),
+    /// A real number (most parameters: `slope_deg`, `depth_m`, ...).
+    Float(f64),
     /// A word (e.g. `sides = "railings"` of `ramp`).
     Text(String),
 }

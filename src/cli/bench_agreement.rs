@@ -5,7 +5,9 @@
 
 use std::time::Instant;
 
-use sim::scan::{Agreement, AgreementContract, ScanConfig, Scanner};
+use anyhow::Context;
+use groundtruth_scenario::{ScanBackend, ScanSetup, ScanSpec};
+use sim::scan::{Agreement, AgreementContract, Scanner};
 
 /// Arguments of `groundtruth bench agreement`.
 #[derive(clap::Args, Debug)]
@@ -41,18 +43,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if !(1..=1000).contains(&args.frames) {
         anyhow::bail!("invalid value for `--frames`: {} (allowed: 1 ..= 1000)", args.frames);
     }
-    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
-    let rig = super::common::load_rig(&args.rig)?;
+    let spec = ScanSpec {
+        scene: args.scene.clone(),
+        rig: args.rig.clone(),
+        seed: args.seed,
+        frames: args.frames as u64,
+        speed_m_per_s: f64::from(args.speed),
+        ideal: args.ideal,
+        ..ScanSpec::default()
+    };
+    let scene = spec.load_scene().with_context(|| format!("loading scene `{}`", args.scene))?;
+    let rig = spec.rig()?;
     let scan = |backend: &str| -> anyhow::Result<(Vec<sim::OrderedCloud>, f64)> {
-        let config = ScanConfig {
-            seed: args.seed,
-            frames: args.frames,
-            speed_m_per_s: args.speed,
-            ideal: args.ideal,
-            backend: super::scan::parse_backend(backend)?,
-            ego_z_m: scene.ego_ground_z_m,
-            ..ScanConfig::default()
-        };
+        let backend = Some(ScanBackend::parse(backend).context("--backend")?);
+        let ScanSetup { config, .. } = ScanSpec { backend, ..spec.clone() }.setup(&scene)?;
         let t0 = Instant::now();
         let scanner = Scanner::new(&scene.mesh, &rig, config)?;
         let clouds = (0..args.frames).map(|k| scanner.frame(k).cloud).collect();

@@ -16,7 +16,6 @@ use std::time::Instant;
 use anyhow::Context;
 use classifier::FrameInput;
 use classifier::recording::{self, FrameReader, Ordering, Recording};
-use sim::scan::ScanConfig;
 
 /// Arguments of `groundtruth bench classify`.
 #[derive(clap::Args, Debug)]
@@ -229,11 +228,13 @@ fn run_in_pool(args: &Args) -> anyhow::Result<()> {
         }
         return run_files(args, &recording);
     }
-    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
-    let rig = super::common::load_rig(&args.rig)?;
-    let config =
-        ScanConfig { seed: args.seed, frames: args.frames, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
-    let frames = sim::scan::scan(&scene.mesh, &rig, &config).context("scanning")?;
+    let frames = super::common::scan_spec(&groundtruth_scenario::ScanSpec {
+        scene: args.scene.clone(),
+        rig: args.rig.clone(),
+        seed: args.seed,
+        frames: args.frames as u64,
+        ..Default::default()
+    })?;
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let repeats = args.repeats.max(1);
     let mut total = Vec::new();

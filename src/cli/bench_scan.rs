@@ -8,9 +8,11 @@
 
 use std::time::Instant;
 
+use anyhow::Context;
+use groundtruth_scenario::{ScanSetup, ScanSpec};
 use rayon::prelude::*;
 use sim::cast::Hit;
-use sim::scan::{ScanConfig, Scanner};
+use sim::scan::Scanner;
 
 /// Arguments of `groundtruth bench scan`.
 #[derive(clap::Args, Debug)]
@@ -27,7 +29,7 @@ pub struct Args {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Scene seed.
+    /// Seed of the scene and the scan.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Ego speed, metres per second (0: a standing vehicle).
@@ -51,22 +53,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
-    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
-    let rig = super::common::load_rig(&args.rig)?;
+    let spec = ScanSpec {
+        scene: args.scene.clone(),
+        rig: args.rig.clone(),
+        seed: args.seed,
+        speed_m_per_s: f64::from(args.speed),
+        ..ScanSpec::default()
+    };
+    let scene = spec.load_scene().with_context(|| format!("loading scene `{}`", args.scene))?;
     let t0 = Instant::now();
-    let config = ScanConfig { ego_z_m: scene.ego_ground_z_m, speed_m_per_s: args.speed, ..ScanConfig::default() };
+    let ScanSetup { config, rig } = spec.setup(&scene)?;
     let prepared = sim::scan::PreparedScene::new(&scene.mesh, config.backend)?;
     let scanner = Scanner::with_prepared(&scene.mesh, &rig, config.clone(), &prepared)?;
     let setup_s = t0.elapsed().as_secs_f64();
     let mut weathers = args
         .weather
         .iter()
-        .map(|spec| {
-            let w = sim::effects::weather::Weather::parse(spec)?;
+        .map(|text| {
+            let w = sim::effects::weather::Weather::parse(text)?;
             let s = Scanner::with_prepared(
                 &scene.mesh,
                 &rig,
-                ScanConfig { weather: Some(w), ..config.clone() },
+                ScanSpec { weather: Some(w), ..spec.clone() }.setup(&scene)?.config,
                 &prepared,
             )?;
             Ok((w, s, f64::INFINITY, 0usize))

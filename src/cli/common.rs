@@ -1,54 +1,21 @@
 //! Shared helpers of the subcommands: resolving scene and rig names or files, and parsing lists.
 
 use anyhow::Context;
+use groundtruth_scenario::ScanSpec;
 use sim::{Rig, SceneMesh};
 
-/// A scene ready to scan: its mesh and the ground height under the ego vehicle.
-pub struct LoadedScene {
-    /// The mesh.
-    pub mesh: SceneMesh,
-    /// Ground height below the ego vehicle's start, metres.
-    pub ego_ground_z_m: f32,
-    /// The scene file's `[weather]`, if any.
-    pub weather: Option<sim::effects::weather::Weather>,
-}
-
+/// A scene ready to scan (the scenario crate's: mesh, ground under the ego vehicle, weather).
+pub use groundtruth_scenario::LoadedScene;
 /// Name of the 1.3 M-triangle benchmark terrain (`sim::cast::fixture`), accepted wherever a scene is.
-pub const FIXTURE_TERRAIN: &str = "fixture-terrain";
+pub use groundtruth_scenario::spec::FIXTURE_TERRAIN;
+/// Every scene name this build knows: bundled, built-in, the benchmark terrain and the families.
+pub use groundtruth_scenario::spec::scene_names;
 
-/// Every scene name this build knows: the simulator's built-ins and the bundled library.
-pub fn scene_names() -> Vec<String> {
-    let mut names: Vec<String> = sim::scene::builtin::NAMES.iter().map(|s| s.to_string()).collect();
-    for n in scenes::bundled_names() {
-        if !names.iter().any(|k| k == n) {
-            names.push(n.to_string());
-        }
-    }
-    names
-}
-
-/// Loads a scene by bundled name, built-in name, or TOML file path, generated with `seed`.
+/// Loads a scene (any name, family, file or TOML text a [`ScanSpec`]'s `scene` takes), generated
+/// with `seed`.
 pub fn load_scene_full(name_or_file: &str, seed: u64) -> anyhow::Result<LoadedScene> {
-    if name_or_file == FIXTURE_TERRAIN {
-        return Ok(LoadedScene { mesh: sim::cast::fixture::terrain_scene(), ego_ground_z_m: 0.0, weather: None });
-    }
-    let is_builtin = sim::scene::builtin::NAMES.contains(&name_or_file);
-    let is_bundled = scenes::bundled_names().contains(&name_or_file);
-    if is_builtin && !is_bundled {
-        return Ok(LoadedScene {
-            mesh: sim::scene::builtin::builtin(name_or_file)?,
-            ego_ground_z_m: 0.0,
-            weather: None,
-        });
-    }
-    if !is_bundled && !name_or_file.ends_with(".toml") {
-        anyhow::bail!(
-            "unknown scene `{name_or_file}`; known: {} (or a path to a .toml scene file)",
-            scene_names().join(", ")
-        );
-    }
-    let scene = scenes::load(name_or_file, seed).with_context(|| format!("loading scene `{name_or_file}`"))?;
-    Ok(LoadedScene { mesh: scene.mesh, ego_ground_z_m: scene.ego_ground_z_m, weather: scene.weather })
+    let spec = ScanSpec { scene: name_or_file.to_string(), seed, ..ScanSpec::default() };
+    spec.load_scene().with_context(|| format!("loading scene `{name_or_file}`"))
 }
 
 /// Loads a scene's mesh (see [`load_scene_full`]).
@@ -56,17 +23,22 @@ pub fn load_scene(name_or_file: &str, seed: u64) -> anyhow::Result<SceneMesh> {
     Ok(load_scene_full(name_or_file, seed)?.mesh)
 }
 
-/// The weather of a scan: `--weather SPEC` when given, else the scene file's `[weather]`.
-pub fn weather(spec: Option<&str>, scene: &LoadedScene) -> anyhow::Result<Option<sim::effects::weather::Weather>> {
-    match spec {
-        Some(s) => Ok(Some(sim::effects::weather::Weather::parse(s).context("--weather")?)),
-        None => Ok(scene.weather),
-    }
+/// Loads a rig by preset name, TOML file path or TOML text.
+pub fn load_rig(name_or_file: &str) -> anyhow::Result<Rig> {
+    groundtruth_scenario::spec::load_rig(name_or_file).with_context(|| format!("loading rig `{name_or_file}`"))
 }
 
-/// Loads a rig by preset name or TOML file path.
-pub fn load_rig(name_or_file: &str) -> anyhow::Result<Rig> {
-    Rig::load(name_or_file).with_context(|| format!("loading rig `{name_or_file}`"))
+/// Scans a spec's scene with its rig: the scene loaded, [`ScanSpec::setup`], every frame cast and
+/// varied as the spec says.
+pub fn scan_spec(spec: &ScanSpec) -> anyhow::Result<Vec<sim::scan::Frame>> {
+    let scene = spec.load_scene().with_context(|| format!("loading scene `{}`", spec.scene))?;
+    let setup = spec.setup(&scene)?;
+    let mut frames = sim::scan::scan(&scene.mesh, &setup.rig, &setup.config)
+        .with_context(|| format!("scanning `{}`", spec.scene))?;
+    for f in &mut frames {
+        spec.vary(&mut f.cloud, f.index)?;
+    }
+    Ok(frames)
 }
 
 /// Splits a comma-separated list, dropping empty items.
@@ -83,10 +55,8 @@ pub fn scan_standing(
     frames: usize,
     ideal: bool,
 ) -> anyhow::Result<Vec<sim::scan::Frame>> {
-    let loaded = load_scene_full(scene, seed)?;
-    let rig = load_rig(rig)?;
-    let config = sim::scan::ScanConfig { seed, frames, ideal, ego_z_m: loaded.ego_ground_z_m, ..Default::default() };
-    sim::scan::scan(&loaded.mesh, &rig, &config).with_context(|| format!("scanning `{scene}`"))
+    let frames = frames as u64;
+    scan_spec(&ScanSpec { scene: scene.to_string(), rig: rig.to_string(), seed, frames, ideal, ..ScanSpec::default() })
 }
 
 pub use classifier::takes_model;

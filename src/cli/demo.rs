@@ -41,13 +41,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let scan_dir = args.out.join("scan");
     let class_dir = args.out.join("classified");
     let scan_args = super::scan::Args {
+        spec: None,
         scene: args.scene.clone(),
         rig: args.rig.clone(),
         out: scan_dir.clone(),
         seed: args.seed,
         frames: args.frames,
-        speed: args.speed,
-        yaw_rate: 0.0,
+        speed_m_per_s: Some(f64::from(args.speed)),
+        speed: None,
+        yaw_rate_deg_per_s: None,
+        yaw_rate: None,
         ideal: false,
         format: "pcd,ply,kitti,las".into(),
         pcd_layout: "groundtruth".into(),

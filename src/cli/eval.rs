@@ -17,7 +17,6 @@ use std::path::PathBuf;
 use anyhow::Context;
 use classifier::metrics::range_band_name;
 use classifier::{Evaluation, FrameInput, Scores};
-use sim::scan::ScanConfig;
 
 /// The methods of Table I, `eval`'s default on a scene.
 const TABLE_METHODS: &str = "nitsch,nitsch-0.7,nitsch-no-cluster,nitsch-no-cluster-0.7,ransac,grid,grid-no-cluster";
@@ -319,17 +318,15 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
     for n in &names {
         super::common::method(n, args.seed, args.model.as_deref().filter(|_| super::common::takes_model(n)))?;
     }
-    let scene = super::common::load_scene_full(scene_name, args.seed)?;
-    let rig = super::common::load_rig(rig_name)?;
-    let config = ScanConfig {
+    let frames = super::common::scan_spec(&groundtruth_scenario::ScanSpec {
+        scene: scene_name.clone(),
+        rig: rig_name.clone(),
         seed: args.seed,
-        frames: args.frames,
-        speed_m_per_s: args.speed_m_per_s,
+        frames: args.frames as u64,
+        speed_m_per_s: f64::from(args.speed_m_per_s),
         ideal: args.ideal,
-        ego_z_m: scene.ego_ground_z_m,
         ..Default::default()
-    };
-    let frames = sim::scan::scan(&scene.mesh, &rig, &config).context("scanning")?;
+    })?;
     println!("scene {scene_name} rig {rig_name} frames {} seed {}", frames.len(), args.seed);
     println!("{:<24} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}", "method", "acc", "FPR", "precision", "recall", "F1", "IoU");
     let mut json: BTreeMap<String, Scores> = BTreeMap::new();

@@ -3,15 +3,38 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use groundtruth_scenario::{ScanBackend, ScanSpec};
 use sim::cast::Backend;
+use sim::effects::weather::Weather;
 use sim::io::formats::{Formats, FrameContext};
 use sim::io::manifest::{FrameEntry, MANIFEST_VERSION, Manifest, SensorEntry, matrix_rows};
-use sim::scan::{ScanConfig, Scanner};
+use sim::scan::Scanner;
+
+/// The flags that describe the scan (refused beside `--spec`, which describes it whole).
+const SPEC_FLAGS: [&str; 11] = [
+    "scene",
+    "rig",
+    "seed",
+    "frames",
+    "speed_m_per_s",
+    "speed",
+    "yaw_rate_deg_per_s",
+    "yaw_rate",
+    "ideal",
+    "weather",
+    "backend",
+];
 
 /// Arguments of `groundtruth scan`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Scene name (see `groundtruth list`) or TOML scene file.
+    /// The whole scan as a spec file (TOML, see docs/scan-spec.md; a manifest's `spec` saved as
+    /// TOML or JSON remakes its files). The flags that describe the scan (--scene, --rig, --seed,
+    /// --frames, --speed-m-per-s, --yaw-rate-deg-per-s, --ideal, --weather, --backend) are refused
+    /// beside it.
+    #[arg(long, conflicts_with_all = SPEC_FLAGS)]
+    pub spec: Option<PathBuf>,
+    /// Scene name (see `groundtruth list`: bundled, built-in, families) or TOML scene file.
     #[arg(long, default_value = "flat-objects")]
     pub scene: String,
     /// Rig preset name (see `groundtruth list`) or TOML rig file.
@@ -26,12 +49,19 @@ pub struct Args {
     /// Number of frames.
     #[arg(long, default_value_t = 1)]
     pub frames: usize,
-    /// Ego speed, metres per second.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub speed: f32,
-    /// Ego yaw rate, radians per second (positive turns left).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub yaw_rate: f32,
+    /// Ego speed, metres per second (-100 ..= 100; default 0).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "speed")]
+    pub speed_m_per_s: Option<f64>,
+    /// Deprecated spelling of --speed-m-per-s (metres per second); removed in the next release.
+    #[arg(long, allow_negative_numbers = true, hide = true)]
+    pub speed: Option<f32>,
+    /// Ego yaw rate, degrees per second (positive turns left; -114.59 ..= 114.59; default 0).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "yaw_rate")]
+    pub yaw_rate_deg_per_s: Option<f64>,
+    /// Deprecated: the yaw rate in radians per second; use --yaw-rate-deg-per-s. Removed in the
+    /// next release.
+    #[arg(long, allow_negative_numbers = true, hide = true)]
+    pub yaw_rate: Option<f32>,
     /// Turn measurement effects off (exact distances, no noise, no quantisation, no dropout).
     #[arg(long)]
     pub ideal: bool,
@@ -68,11 +98,56 @@ pub struct Args {
 
 /// Parses a backend name.
 pub fn parse_backend(name: &str) -> anyhow::Result<Backend> {
-    match name {
-        "bvh" => Ok(Backend::Bvh),
-        "parry" => Ok(Backend::Parry),
-        "gpu" => Ok(Backend::Gpu),
-        other => anyhow::bail!("unknown --backend `{other}`; allowed: bvh, parry, gpu"),
+    Ok(ScanBackend::parse(name).context("--backend")?.to_sim())
+}
+
+impl Args {
+    /// The scan these arguments describe: the `--spec` file, else the flags (the deprecated
+    /// spellings say so on stderr).
+    pub fn scan_spec(&self) -> anyhow::Result<ScanSpec> {
+        if let Some(path) = &self.spec {
+            let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+            let source = path.display().to_string();
+            // A manifest's `spec` saved as JSON reads too.
+            let mut spec = if text.trim_start().starts_with('{') {
+                let value = serde_json::from_str(&text).with_context(|| format!("{source}: not JSON"))?;
+                ScanSpec::from_json_value(value, &source)?
+            } else {
+                ScanSpec::from_toml_str(&text, &source)?
+            };
+            // The manifest says which backend made the files, given or not.
+            spec.backend.get_or_insert_with(ScanBackend::default);
+            return Ok(spec);
+        }
+        let mut spec = ScanSpec {
+            scene: self.scene.clone(),
+            seed: self.seed,
+            rig: self.rig.clone(),
+            frames: self.frames as u64,
+            ideal: self.ideal,
+            weather: self.weather.as_deref().map(Weather::parse).transpose().context("--weather")?,
+            backend: Some(ScanBackend::parse(&self.backend).context("--backend")?),
+            ..ScanSpec::default()
+        };
+        if let Some(v) = self.speed {
+            eprintln!("warning: --speed is deprecated, use --speed-m-per-s (the same metres per second)");
+            spec.speed_m_per_s = f64::from(v);
+        }
+        if let Some(v) = self.speed_m_per_s {
+            spec.speed_m_per_s = v;
+        }
+        if let Some(v) = self.yaw_rate {
+            eprintln!(
+                "warning: --yaw-rate (radians per second) is deprecated, use --yaw-rate-deg-per-s ({} deg/s)",
+                f64::from(v).to_degrees()
+            );
+            spec.set_yaw_rate_rad_per_s(v);
+        }
+        if let Some(v) = self.yaw_rate_deg_per_s {
+            spec.yaw_rate_deg_per_s = v;
+        }
+        spec.validate()?;
+        Ok(spec)
     }
 }
 
@@ -112,21 +187,12 @@ pub const BAG_DIR: &str = "bag";
 pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
     let mut formats = Formats::parse(&args.format)?;
     formats.pcd_layout = sim::io::pcd::PcdLayout::parse(&args.pcd_layout)?;
-    let backend = parse_backend(&args.backend)?;
-    let scene = super::common::load_scene_full(&args.scene, args.seed)?;
-    let rig = super::common::load_rig(&args.rig)?;
-    let weather = super::common::weather(args.weather.as_deref(), &scene)?;
-    let config = ScanConfig {
-        seed: args.seed,
-        frames: args.frames,
-        speed_m_per_s: args.speed,
-        yaw_rate_rad_per_s: args.yaw_rate,
-        ideal: args.ideal,
-        backend,
-        ego_z_m: scene.ego_ground_z_m,
-        waypoints_m: Vec::new(),
-        weather,
-    };
+    let spec = args.scan_spec()?;
+    let scene = spec.load_scene().with_context(|| format!("loading scene `{}`", spec.scene))?;
+    let setup = spec.setup(&scene)?;
+    let (rig, config) = (setup.rig, setup.config);
+    let (frame_count, weather) = (config.frames, config.weather);
+    let (speed_m_per_s, yaw_rate_rad_per_s) = (config.speed_m_per_s, config.yaw_rate_rad_per_s);
     let scanner = Scanner::new(&scene.mesh, &rig, config)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating output directory {}", args.out.display()))?;
 
@@ -189,8 +255,9 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         // Frames in order; with a device caster the next frames are cast while this one is
         // measured (`Scanner::scan_frames`). A failed writer has dropped the receiver: stop
         // casting and report its error.
-        let cast = scanner.scan_frames(0..args.frames, |frame| -> anyhow::Result<()> {
+        let cast = scanner.scan_frames(0..frame_count, |mut frame| -> anyhow::Result<()> {
             crate::cli::common::check_device(scanner.caster())?;
+            spec.vary(&mut frame.cloud, frame.index)?;
             sender.send(frame).map_err(|_| anyhow::anyhow!("the writer stopped"))
         });
         drop(sender);
@@ -223,13 +290,13 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
     let manifest = Manifest {
         version: MANIFEST_VERSION,
         generator: format!("groundtruth {}", env!("CARGO_PKG_VERSION")),
-        scene: args.scene.clone(),
-        rig: args.rig.clone(),
-        seed: args.seed,
-        ideal: args.ideal,
-        speed_m_per_s: args.speed,
-        yaw_rate_rad_per_s: args.yaw_rate,
-        weather: weather.filter(|_| !args.ideal).map(|w| w.spec()),
+        scene: if spec.scene.is_empty() { spec.family.clone().unwrap_or_default() } else { spec.scene.clone() },
+        rig: spec.rig.clone(),
+        seed: spec.seed,
+        ideal: spec.ideal,
+        speed_m_per_s,
+        yaw_rate_rad_per_s,
+        weather: weather.filter(|_| !spec.ideal).map(|w| w.spec()),
         frame_period_s: scanner.frame_period_s(),
         kitti_frame: if single { "sensor" } else { "vehicle" }.to_string(),
         pcd_layout: formats.pcd_layout.name().to_string(),
@@ -237,6 +304,7 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
         ordering: sim::layout::ORDERING.to_string(),
         sensors,
         frames,
+        spec: Some(serde_json::to_value(&spec)?),
     };
     manifest.write(Path::new(&args.out))?;
     Ok(manifest)

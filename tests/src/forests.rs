@@ -3,7 +3,6 @@
 //! branches/leaves), next to the "sensed points" of the paper's Tables I-III. Used by the
 //! `forest_shares` example (prints the table) and by `tests/forests.rs` (asserts it).
 
-use sim::scan::{ScanConfig, scan};
 use sim::{OrderedCloud, Rig, SemanticClass};
 
 /// The four categories of seed 002's hand labels, in table order.
@@ -131,9 +130,9 @@ impl Counts {
 /// Scans bundled `scene` at `seed` with `rig` standing at the ego origin (one frame, default
 /// measurement: range noise on, as users get it) and counts the returns.
 pub fn measure(scene: &str, rig: &Rig, seed: u64) -> Counts {
-    let s = scenes::load(scene, seed).unwrap_or_else(|e| panic!("{scene}: {e}"));
-    let config = ScanConfig { seed, frames: 1, ego_z_m: s.ego_ground_z_m, ..Default::default() };
-    let frames = scan(&s.mesh, rig, &config).unwrap_or_else(|e| panic!("{scene}: {e}"));
+    let spec = crate::ScanSpec { scene: scene.to_string(), seed, ..crate::ScanSpec::default() };
+    let s = spec.load_scene().unwrap_or_else(|e| panic!("{scene}: {e}"));
+    let frames = crate::scan_on(&s, rig, &spec);
     Counts::of(&frames[0].cloud)
 }
 

@@ -5,7 +5,8 @@ pub mod forests;
 pub mod real_files;
 
 use classifier::{Evaluation, FrameInput, method_by_name};
-use sim::scan::{Frame, ScanConfig, scan};
+pub use groundtruth_scenario::{LoadedScene, ScanSpec};
+use sim::scan::{Frame, scan};
 
 /// A scanned and classified scenario.
 pub struct Scenario {
@@ -20,11 +21,30 @@ pub struct Scenario {
 /// Scans `scene` (bundled name, seed 0) with rig preset `rig` for `frames` frames at `speed` m/s and
 /// classifies every frame with `method`.
 pub fn run(scene: &str, rig: &str, method: &str, frames: usize, speed: f32) -> Scenario {
-    let scene = scenes::load(scene, 0).expect("bundled scene");
-    let rig = sim::Rig::preset(rig).expect("rig preset");
-    let config = ScanConfig { frames, speed_m_per_s: speed, ego_z_m: scene.ego_ground_z_m, ..ScanConfig::default() };
-    let frames = scan(&scene.mesh, &rig, &config).expect("scan");
-    classify(frames, method)
+    let spec = ScanSpec {
+        scene: scene.to_string(),
+        rig: rig.to_string(),
+        frames: frames as u64,
+        speed_m_per_s: f64::from(speed),
+        ..ScanSpec::default()
+    };
+    classify(scan_spec(&spec).0, method)
+}
+
+/// Scans what `spec` describes (the scenario crate's one path from a description to the
+/// scanner); returns the frames and the rig they were scanned with.
+pub fn scan_spec(spec: &ScanSpec) -> (Vec<Frame>, sim::Rig) {
+    let scene = spec.load_scene().unwrap_or_else(|e| panic!("{}: {e}", spec.scene));
+    let setup = spec.setup(&scene).unwrap_or_else(|e| panic!("{}: {e}", spec.scene));
+    let frames = scan(&scene.mesh, &setup.rig, &setup.config).unwrap_or_else(|e| panic!("{}: {e}", spec.scene));
+    (frames, setup.rig)
+}
+
+/// Scans `scene` (loaded, or a test's mesh through [`LoadedScene::from_mesh`]) with `rig` as
+/// `spec` says (its `scene` and `rig` fields unused).
+pub fn scan_on(scene: &LoadedScene, rig: &sim::Rig, spec: &ScanSpec) -> Vec<Frame> {
+    let setup = spec.setup_with_rig(scene, rig.clone()).unwrap_or_else(|e| panic!("{e}"));
+    scan(&scene.mesh, &setup.rig, &setup.config).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Classifies scanned frames with `method`.
@@ -59,7 +79,7 @@ pub fn cloud_bits(c: &sim::OrderedCloud) -> Vec<u64> {
     v
 }
 
-/// Scans `mesh` with `rig` on a pool of `threads` worker threads.
-pub fn scan_with_threads(threads: usize, mesh: &sim::SceneMesh, rig: &sim::Rig, config: &ScanConfig) -> Vec<Frame> {
-    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| scan(mesh, rig, config).unwrap())
+/// [`scan_on`] on a pool of `threads` worker threads.
+pub fn scan_with_threads(threads: usize, scene: &LoadedScene, rig: &sim::Rig, spec: &ScanSpec) -> Vec<Frame> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| scan_on(scene, rig, spec))
 }

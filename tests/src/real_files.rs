@@ -6,7 +6,6 @@
 use classifier::ordering::{BeamTable, OrderingReport, PathChoice, PointAttributes, UnfoldParams, order_cloud};
 use classifier::{Confusion, method_by_name};
 use glam::Vec3;
-use sim::scan::{ScanConfig, scan};
 
 /// One frame compared through the `.bin` path and on its own grid.
 #[derive(Clone, Debug)]
@@ -37,11 +36,9 @@ pub fn compare_bin(
     shuffle: bool,
     choice: PathChoice,
 ) -> BinComparison {
-    let loaded = scenes::load(scene, seed).expect("bundled scene");
-    let rig = sim::Rig::preset(rig).expect("rig preset");
+    let spec = crate::ScanSpec { scene: scene.to_string(), rig: rig.to_string(), seed, ..crate::ScanSpec::default() };
+    let (frames, rig) = crate::scan_spec(&spec);
     assert_eq!(rig.sensors.len(), 1, "single-sensor rig");
-    let config = ScanConfig { seed, frames: 1, ego_z_m: loaded.ego_ground_z_m, ..ScanConfig::default() };
-    let frames = scan(&loaded.mesh, &rig, &config).expect("scan");
     let cloud = &frames[0].cloud;
     let vehicle_from_sensor = rig.sensors[0].mount.vehicle_from_sensor();
     let sensor_from_vehicle = vehicle_from_sensor.inverse();
@@ -118,10 +115,8 @@ pub struct LayoutAgreement {
 pub fn layout_agreement(scene: &str, rig: &str, seed: u64, method: &str) -> Vec<LayoutAgreement> {
     use classifier::ordering::{decisions_per_point, order_organized};
     use sim::io::pcd::{PcdLayout, encode_layout, read_bytes_with_info};
-    let loaded = scenes::load(scene, seed).expect("bundled scene");
-    let rig_v = sim::Rig::preset(rig).expect("rig preset");
-    let config = ScanConfig { seed, frames: 1, ego_z_m: loaded.ego_ground_z_m, ..ScanConfig::default() };
-    let frames = scan(&loaded.mesh, &rig_v, &config).expect("scan");
+    let spec = crate::ScanSpec { scene: scene.to_string(), rig: rig.to_string(), seed, ..crate::ScanSpec::default() };
+    let (frames, rig_v) = crate::scan_spec(&spec);
     let cloud = &frames[0].cloud;
     let (rows, cols) = (cloud.rows, cloud.cols);
     let classify = |c: &sim::OrderedCloud| {

@@ -7,7 +7,6 @@
 
 use gt_tests::forests::{self, NEAR_M, PAPER, ROOF_RIGS};
 use sim::SemanticClass;
-use sim::scan::{ScanConfig, scan};
 
 /// Seeds asserted here (the example checks more).
 const SEEDS: [u64; 3] = [0, 1, 2];
@@ -73,10 +72,9 @@ fn every_roof_rig_sees_ground_around_the_vehicle_in_every_forest() {
 
 #[test]
 fn bushes_are_their_own_class_and_map_to_vegetation_in_kitti_and_medium_vegetation_in_las() {
-    let scene = scenes::load("forest-moderate", 0).unwrap();
-    let rig = sim::Rig::preset("utm30lx-nodding").unwrap();
-    let config = ScanConfig { ego_z_m: scene.ego_ground_z_m, ..Default::default() };
-    let cloud = &scan(&scene.mesh, &rig, &config).unwrap()[0].cloud;
+    let spec =
+        gt_tests::ScanSpec { scene: "forest-moderate".into(), rig: "utm30lx-nodding".into(), ..Default::default() };
+    let cloud = &gt_tests::scan_spec(&spec).0[0].cloud;
     let count =
         |class: SemanticClass| (0..cloud.len()).filter(|&i| cloud.has_return(i) && cloud.label[i] == class).count();
     let (bush, canopy, trunk) =

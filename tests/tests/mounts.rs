@@ -3,9 +3,9 @@
 //! finding the ground.
 
 use glam::Vec3;
+use gt_tests::{LoadedScene, ScanSpec, scan_on};
 use proptest::prelude::*;
 use sim::rig::{Mount, Rig};
-use sim::scan::{ScanConfig, scan};
 use sim::scene::builtin;
 
 fn vlp16_at(mount: Mount) -> Rig {
@@ -28,7 +28,7 @@ proptest! {
         let mount = Mount { x_m: x, y_m: 0.0, z_m: height, roll_deg: roll, pitch_deg: pitch, yaw_deg: yaw };
         let rig = vlp16_at(mount);
         let mesh = builtin::flat_objects();
-        let frames = scan(&mesh, &rig, &ScanConfig { ideal: true, ..ScanConfig::default() }).unwrap();
+        let frames = scan_on(&LoadedScene::from_mesh(mesh, "flat-objects"), &rig, &ScanSpec { ideal: true, ..ScanSpec::default() });
         let c = &frames[0].cloud;
         let vehicle_from_sensor = mount.vehicle_from_sensor();
         let origin = vehicle_from_sensor.transform_point3(Vec3::ZERO);

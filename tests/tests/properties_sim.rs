@@ -9,13 +9,12 @@
 
 use glam::{Affine3A, Vec3};
 use groundtruth_scenario::strategies::config;
-use gt_tests::{cloud_bits, scan_with_threads};
+use gt_tests::{LoadedScene, ScanSpec, cloud_bits, scan_on, scan_spec, scan_with_threads};
 use parry3d::math::Pose;
 use parry3d::query::{Ray, RayCast};
 use parry3d::shape::{Ball, Cuboid};
 use proptest::prelude::*;
 use sim::rig::{Mount, Rig};
-use sim::scan::{ScanConfig, scan};
 use sim::{SceneMesh, SemanticClass, Surface};
 
 /// Sphere tessellation: 64 subdivisions around, 32 from pole to pole.
@@ -81,7 +80,7 @@ proptest! {
         };
         let mesh = shapes.mesh(Vec3::ZERO);
         let mount = Mount { x_m: 1.3, y_m: 0.0, z_m: height, roll_deg: 0.0, pitch_deg: pitch, yaw_deg: 0.0 };
-        let frames = scan(&mesh, &vlp16_at(mount), &ScanConfig { ideal: true, ..ScanConfig::default() }).unwrap();
+        let frames = scan_on(&LoadedScene::from_mesh(mesh, "shapes"), &vlp16_at(mount), &ScanSpec { ideal: true, ..ScanSpec::default() });
         let f = &frames[0];
         prop_assert_eq!(f.vehicle_pose.z_m, 0.0);
         let c = &f.cloud;
@@ -142,10 +141,8 @@ proptest! {
         seed in 0u64..1000,
         ideal in any::<bool>(),
     ) {
-        let scene = scenes::load_bundled(scene, seed).unwrap();
-        let rig = Rig::preset(rig).unwrap();
-        let config = ScanConfig { seed, ideal, ego_z_m: scene.ego_ground_z_m, ..ScanConfig::default() };
-        let frames = scan(&scene.mesh, &rig, &config).unwrap();
+        let spec = ScanSpec { scene: scene.to_string(), rig: rig.to_string(), seed, ideal, ..ScanSpec::default() };
+        let (frames, rig) = scan_spec(&spec);
         let c = &frames[0].cloud;
         let pattern = rig.sensors[0].spec.pattern();
         prop_assert_eq!((c.rows, c.cols), (pattern.rows, pattern.cols));
@@ -169,11 +166,11 @@ proptest! {
         seed in 0u64..1_000_000,
         speed in 0.0f32..20.0,
     ) {
-        let scene = scenes::load_bundled(scene, seed).unwrap();
+        let spec = ScanSpec { scene: scene.to_string(), seed, frames: 2, speed_m_per_s: f64::from(speed), ..ScanSpec::default() };
+        let scene = spec.load_scene().unwrap();
         let rig = Rig::preset("vlp16-roof").unwrap();
-        let config = ScanConfig { seed, frames: 2, speed_m_per_s: speed, ego_z_m: scene.ego_ground_z_m, ..ScanConfig::default() };
-        let one = scan_with_threads(1, &scene.mesh, &rig, &config);
-        let two = scan_with_threads(2, &scene.mesh, &rig, &config);
+        let one = scan_with_threads(1, &scene, &rig, &spec);
+        let two = scan_with_threads(2, &scene, &rig, &spec);
         for (a, b) in one.iter().zip(&two) {
             prop_assert!(cloud_bits(&a.cloud) == cloud_bits(&b.cloud), "frame {} differs", a.index);
         }
@@ -195,9 +192,9 @@ proptest! {
         let d = Vec3::new(d.0, d.1, d.2);
         let m0 = Mount { x_m: 1.3, y_m: 0.0, z_m: height, roll_deg: 0.0, pitch_deg: pitch, yaw_deg: 0.0 };
         let m1 = Mount { x_m: m0.x_m + d.x, y_m: m0.y_m + d.y, z_m: m0.z_m + d.z, ..m0 };
-        let config = ScanConfig { ideal: true, ..ScanConfig::default() };
-        let a = scan(&shapes.mesh(Vec3::ZERO), &vlp16_at(m0), &config).unwrap();
-        let b = scan(&shapes.mesh(d), &vlp16_at(m1), &config).unwrap();
+        let spec = ScanSpec { ideal: true, ..ScanSpec::default() };
+        let a = scan_on(&LoadedScene::from_mesh(shapes.mesh(Vec3::ZERO), "shapes"), &vlp16_at(m0), &spec);
+        let b = scan_on(&LoadedScene::from_mesh(shapes.mesh(d), "shapes moved"), &vlp16_at(m1), &spec);
         prop_assert_eq!(a[0].world_from_vehicle, Affine3A::IDENTITY);
         prop_assert_eq!(b[0].world_from_vehicle, Affine3A::IDENTITY);
         let (a, b) = (&a[0].cloud, &b[0].cloud);

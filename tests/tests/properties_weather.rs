@@ -14,11 +14,10 @@
 
 use groundtruth_scenario::strategies::{self, config};
 use groundtruth_scenario::{Region, RegionScore, Scan, Scenario, Weather};
-use gt_tests::{cloud_bits, scan_with_threads};
+use gt_tests::{ScanSpec, cloud_bits, scan_with_threads};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use sim::rig::Rig;
-use sim::scan::ScanConfig;
 use sim::scene::SemanticClass;
 
 const METHODS: [&str; 5] = ["nitsch", "ransac", "grid", "mcdaniel", "learned"];
@@ -96,11 +95,11 @@ proptest! {
         seed in 0u64..1_000_000,
         weather in strategies::weather(),
     ) {
-        let scene = scenes::load_bundled(scene, seed).unwrap();
+        let spec = ScanSpec { scene: scene.to_string(), seed, frames: 2, speed_m_per_s: 8.0, weather: Some(weather), ..ScanSpec::default() };
+        let scene = spec.load_scene().unwrap();
         let rig = Rig::preset("vlp16-roof").unwrap();
-        let config = ScanConfig { seed, frames: 2, speed_m_per_s: 8.0, ego_z_m: scene.ego_ground_z_m, weather: Some(weather), ..ScanConfig::default() };
-        let one = scan_with_threads(1, &scene.mesh, &rig, &config);
-        let two = scan_with_threads(2, &scene.mesh, &rig, &config);
+        let one = scan_with_threads(1, &scene, &rig, &spec);
+        let two = scan_with_threads(2, &scene, &rig, &spec);
         for (a, b) in one.iter().zip(&two) {
             prop_assert!(cloud_bits(&a.cloud) == cloud_bits(&b.cloud), "frame {} differs ({weather:?})", a.index);
         }

@@ -55,9 +55,8 @@ fn forest_ground_is_found_under_the_trees_by_the_nodding_laser() {
     let rig_file = concat!(env!("CARGO_MANIFEST_DIR"), "/../sim/rigs/nodding-180.toml");
     let rig = sim::Rig::load(rig_file).unwrap();
     for name in ["forest-sparse", "forest-moderate"] {
-        let scene = scenes::load(name, 0).unwrap();
-        let config = sim::scan::ScanConfig { ideal: true, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
-        let frames = sim::scan::scan(&scene.mesh, &rig, &config).unwrap();
+        let spec = gt_tests::ScanSpec { scene: name.to_string(), ideal: true, ..Default::default() };
+        let frames = gt_tests::scan_on(&spec.load_scene().unwrap(), &rig, &spec);
         assert_eq!((frames[0].cloud.rows, frames[0].cloud.cols), (200, 721));
         let sc = gt_tests::classify(frames, "nitsch").eval.pooled.scores();
         eprintln!("{name} nodding-180 ideal: {sc:?}");
@@ -80,10 +79,10 @@ fn nitsch_on_the_270_deg_nodding_rig_finds_the_ground_as_at_180() {
     let rig_180 = sim::Rig::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../sim/rigs/nodding-180.toml")).unwrap();
     let rig_270 = sim::Rig::preset("utm30lx-nodding").unwrap();
     for name in ["forest-sparse", "forest-moderate", "forest-dense"] {
-        let scene = scenes::load(name, 0).unwrap();
-        let config = sim::scan::ScanConfig { ideal: true, ego_z_m: scene.ego_ground_z_m, ..Default::default() };
+        let spec = gt_tests::ScanSpec { scene: name.to_string(), ideal: true, ..Default::default() };
+        let scene = spec.load_scene().unwrap();
         let f1 = |rig: &sim::Rig| {
-            let frames = sim::scan::scan(&scene.mesh, rig, &config).unwrap();
+            let frames = gt_tests::scan_on(&scene, rig, &spec);
             gt_tests::classify(frames, "nitsch").eval.pooled.scores()
         };
         let (s180, s270) = (f1(&rig_180), f1(&rig_270));

@@ -24,6 +24,11 @@ pub fn sequence_setups(dir: &Path) -> Result<Option<BTreeMap<String, SensorSetup
     if m.get("format").and_then(|f| f.as_str()) != Some(MANIFEST_FORMAT) {
         return Ok(None);
     }
+    // Each sequence's mounts as scanned (manifests since scan specs; any override mode applied).
+    let scanned_mounts = |id: u64| -> Option<Vec<sim::rig::Mount>> {
+        let entry = m["sequences"].as_array()?.iter().find(|e| e["id"].as_u64() == Some(id))?;
+        serde_json::from_value(entry.get("mounts")?.clone()).ok()
+    };
     let mut out = BTreeMap::new();
     for s in m["config"]["sequences"].as_array().into_iter().flatten() {
         let (Some(id), Some(rig)) = (s["id"].as_u64(), s["rig"].as_str()) else {
@@ -33,7 +38,12 @@ pub fn sequence_setups(dir: &Path) -> Result<Option<BTreeMap<String, SensorSetup
         if r.sensors.len() != 1 {
             continue;
         }
-        if let Some(mount) = s.get("mount").and_then(|m| m.as_object()) {
+        if let Some(mounts) = scanned_mounts(id) {
+            let [mount] = mounts.as_slice() else {
+                return Err(invalid(format!("sequence {id}: one mount per sensor of its rig")));
+            };
+            r.sensors[0].mount = *mount;
+        } else if let Some(mount) = s.get("mount").and_then(|m| m.as_object()) {
             let m = &mut r.sensors[0].mount;
             for (field, slot, limit) in [
                 ("x_m", &mut m.x_m, 100.0),

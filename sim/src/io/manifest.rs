@@ -100,6 +100,10 @@ pub struct Manifest {
     pub sensors: Vec<SensorEntry>,
     /// The frames.
     pub frames: Vec<FrameEntry>,
+    /// The full description the scan was made from (`groundtruth_scenario::ScanSpec` as JSON;
+    /// `groundtruth scan --spec` takes it back to remake the files). Absent in older manifests.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spec: Option<serde_json::Value>,
 }
 
 fn default_pcd_layout() -> String {

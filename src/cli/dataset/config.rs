@@ -10,7 +10,8 @@
 //! scene = "city"                       # a scene name (`groundtruth list`) or a .toml scene file
 //! seed = 1                             # scene generator and measurement noise
 //! rig = "hdl64e-roof"                  # a rig preset or a .toml rig file
-//! mount = { z_m = 1.9, pitch_deg = 1 } # optional: overrides of a single-sensor rig's mount
+//! mount = { z_m = 1.9, pitch_deg = 1 } # optional: the mount override (ScanSpec's: a `sensor` and
+//!                                      # `mode` absolute/relative; limits +-100 m, +-360 deg)
 //! frames = 100                         # 1 ..= 100,000 (the simulator's limit per sequence)
 //! speed_m_per_s = 10.0                 # constant speed, 0 ..= 100 m/s
 //! yaw_rate_deg_per_s = 0.0             # constant yaw rate (|w| <= 114 deg/s), or:
@@ -20,14 +21,17 @@
 //! ideal = false                        # optional: no measurement effects
 //! ```
 //!
-//! The frame rate is the rig's (its slowest sensor). Unknown fields, an unknown scene or rig, a
+//! A sequence's fields besides `id` and `formats` are a `groundtruth_scenario::ScanSpec` (also
+//! `params`, `family`, `noise_scale`, `dropout`, `intensity_scale`, `weather`), checked as every
+//! front end checks it. The frame rate is the rig's (its slowest sensor). Unknown fields, an unknown scene or rig, a
 //! trajectory that leaves the scene's extent, zero or negative speed with waypoints, a frame count
 //! of 0 or more than the limit, duplicate ids and ids over 99 are refused with the field named.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 use std::path::Path;
 
 use anyhow::{Context, bail};
+use groundtruth_scenario::ScanSpec;
 use serde::{Deserialize, Serialize};
 
 /// Largest number of frames in a whole dataset without `--allow-large`.
@@ -80,70 +84,27 @@ pub struct Split {
     pub test: Vec<u32>,
 }
 
-/// Overrides of a mount's fields (metres, degrees; see `sim::Mount`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-pub struct MountOverride {
-    /// Position x, metres.
-    pub x_m: Option<f32>,
-    /// Position y, metres.
-    pub y_m: Option<f32>,
-    /// Position z, metres.
-    pub z_m: Option<f32>,
-    /// Roll, degrees.
-    pub roll_deg: Option<f32>,
-    /// Pitch, degrees.
-    pub pitch_deg: Option<f32>,
-    /// Yaw, degrees.
-    pub yaw_deg: Option<f32>,
-}
-
-/// One sequence: a scene, a rig and a trajectory.
+/// One sequence: its id, the scan (a [`ScanSpec`], its fields beside `id` in the sequence's
+/// table) and the extra files per frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SequenceConfig {
     /// Sequence id, `0 ..= 99` (folder `sequences/NN`).
     pub id: u32,
-    /// Scene name or TOML file.
-    pub scene: String,
-    /// Seed of the scene generator and the measurement noise.
-    #[serde(default)]
-    pub seed: u64,
-    /// Rig preset name or TOML file.
-    pub rig: String,
-    /// Mount overrides (single-sensor rigs).
-    #[serde(default)]
-    pub mount: Option<MountOverride>,
-    /// Number of frames.
-    pub frames: u64,
-    /// Ego speed, metres per second.
-    #[serde(default)]
-    pub speed_m_per_s: f64,
-    /// Ego yaw rate, degrees per second (positive: left).
-    #[serde(default)]
-    pub yaw_rate_deg_per_s: f64,
-    /// Waypoints `[x, y]` (world frame, metres) followed at `speed_m_per_s`.
-    #[serde(default)]
-    pub waypoints_m: Option<Vec<[f64; 2]>>,
-    /// Extra files per frame beside `velodyne/`: any of `pcd`, `ply`, `las`.
+    /// The scan: scene, seed, rig, mount, frames, motion, effects, weather.
+    #[serde(flatten)]
+    pub spec: ScanSpec,
+    /// Extra files per frame beside `velodyne/`: any of `pcd`, `ply`, `las`; `mcap`: a bag.
     #[serde(default)]
     pub formats: Vec<String>,
-    /// No measurement effects.
-    #[serde(default)]
-    pub ideal: bool,
-    /// Range noise as a multiple of the sensor's own (`range_sigma_m`), 0 ..= 10.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub noise_scale: Option<f64>,
-    /// Probability that a return is dropped at random, 0 ..= 0.9.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub dropout: Option<f64>,
-    /// Intensities multiplied by this (clamped to 1), 0 ..= 10.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub intensity_scale: Option<f64>,
-    /// Weather of this sequence (`weather = { kind = "snow", rate_mm_h = 2 }`); default the
-    /// dataset's `[weather]`, else the scene file's.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub weather: Option<sim::effects::weather::Weather>,
+}
+
+impl std::ops::Deref for SequenceConfig {
+    type Target = ScanSpec;
+
+    fn deref(&self) -> &ScanSpec {
+        &self.spec
+    }
 }
 
 impl DatasetConfig {
@@ -165,8 +126,8 @@ impl DatasetConfig {
             self.sequences.extend(drawn);
         }
         if let Some(w) = self.weather {
-            for s in self.sequences.iter_mut().filter(|s| s.weather.is_none()) {
-                s.weather = Some(w);
+            for s in self.sequences.iter_mut().filter(|s| s.spec.weather.is_none()) {
+                s.spec.weather = Some(w);
             }
         }
         Ok(())
@@ -181,8 +142,9 @@ impl DatasetConfig {
         let mut total = 0u64;
         for (k, s) in self.sequences.iter().enumerate() {
             let at = format!("sequences[{k}]");
-            if let Some(w) = &s.weather {
-                w.validate().map_err(|e| anyhow::anyhow!("`{at}.weather`: {e}"))?;
+            s.spec.validate().map_err(|e| anyhow::anyhow!("`{at}`: {e}"))?;
+            if s.spec.backend.is_some() {
+                bail!("`{at}.backend`: a dataset's backend is the command line's --backend");
             }
             if s.id > MAX_SEQUENCE_ID {
                 bail!("`{at}.id` = {}: allowed 0 ..= {MAX_SEQUENCE_ID} (two-digit SemanticKITTI folders)", s.id);
@@ -190,45 +152,7 @@ impl DatasetConfig {
             if !ids.insert(s.id) {
                 bail!("`{at}.id` = {}: a duplicate sequence id", s.id);
             }
-            if s.frames == 0 || s.frames > sim::scan::MAX_FRAMES as u64 {
-                bail!(
-                    "`{at}.frames` = {}: allowed 1 ..= {} per sequence (the simulator's limit)",
-                    s.frames,
-                    sim::scan::MAX_FRAMES
-                );
-            }
             total += s.frames;
-            if !(s.speed_m_per_s.is_finite() && (-100.0..=100.0).contains(&s.speed_m_per_s)) {
-                bail!("`{at}.speed_m_per_s` = {}: allowed -100 ..= 100", s.speed_m_per_s);
-            }
-            if !(s.yaw_rate_deg_per_s.is_finite() && s.yaw_rate_deg_per_s.abs() <= 2f64.to_degrees()) {
-                bail!("`{at}.yaw_rate_deg_per_s` = {}: allowed -114.59 ..= 114.59", s.yaw_rate_deg_per_s);
-            }
-            if let Some(w) = &s.waypoints_m {
-                if w.len() < 2 {
-                    bail!("`{at}.waypoints_m`: {} point(s); a path needs 2 or more", w.len());
-                }
-                if let Some(p) = w.iter().find(|p| !p.iter().all(|v| v.is_finite() && v.abs() <= 1e6)) {
-                    bail!("`{at}.waypoints_m`: point {p:?} is not finite or beyond 1e6 m");
-                }
-                if s.speed_m_per_s <= 0.0 {
-                    bail!("`{at}.speed_m_per_s` = {}: must be > 0 with waypoints", s.speed_m_per_s);
-                }
-                if s.yaw_rate_deg_per_s != 0.0 {
-                    bail!("`{at}`: give waypoints_m or yaw_rate_deg_per_s, not both");
-                }
-            }
-            for (name, value, max) in [
-                ("noise_scale", s.noise_scale, 10.0),
-                ("dropout", s.dropout, 0.9),
-                ("intensity_scale", s.intensity_scale, 10.0),
-            ] {
-                if let Some(v) = value
-                    && !(v.is_finite() && (0.0..=max).contains(&v))
-                {
-                    bail!("`{at}.{name}` = {v}: allowed 0 ..= {max}");
-                }
-            }
             for f in &s.formats {
                 if !["pcd", "ply", "las", "mcap"].contains(&f.as_str()) {
                     bail!("`{at}.formats`: unknown format `{f}`; allowed: pcd, ply, las, mcap");
@@ -255,36 +179,113 @@ impl DatasetConfig {
             .unwrap_or_else(|| Split { train: self.sequences.iter().map(|s| s.id).collect(), ..Split::default() })
     }
 
-    /// The canonical JSON of the configuration (what the manifest's id is the hash of).
+    /// The canonical JSON of the configuration (what the manifest's id is the hash of): the shape
+    /// it had before sequences were scan specs, so that a dataset keeps its id (and `--resume`
+    /// keeps working) across that change; fields that only a scan spec has follow when set.
     pub fn canonical(&self) -> String {
-        serde_json::to_string(self).unwrap_or_default()
+        let sequences = self.sequences.iter().map(CanonicalSequence::of).collect();
+        let c = CanonicalConfig {
+            name: &self.name,
+            split: &self.split,
+            sequences,
+            generate: &self.generate,
+            train: &self.train,
+            weather: &self.weather,
+        };
+        serde_json::to_string(&c).unwrap_or_default()
     }
 }
 
-/// Applies mount overrides to a single-sensor rig; refused for rigs of several sensors.
-pub fn apply_mount(rig: &mut sim::Rig, mount: &MountOverride, at: &str) -> anyhow::Result<()> {
-    if rig.sensors.len() != 1 {
-        bail!("`{at}.mount`: the rig has {} sensors; mount overrides apply to single-sensor rigs", rig.sensors.len());
-    }
-    let m = &mut rig.sensors[0].mount;
-    let fields: BTreeMap<&str, (Option<f32>, &mut f32)> = BTreeMap::from([
-        ("x_m", (mount.x_m, &mut m.x_m)),
-        ("y_m", (mount.y_m, &mut m.y_m)),
-        ("z_m", (mount.z_m, &mut m.z_m)),
-        ("roll_deg", (mount.roll_deg, &mut m.roll_deg)),
-        ("pitch_deg", (mount.pitch_deg, &mut m.pitch_deg)),
-        ("yaw_deg", (mount.yaw_deg, &mut m.yaw_deg)),
-    ]);
-    for (name, (value, slot)) in fields {
-        if let Some(v) = value {
-            let limit = if name.ends_with("_m") { 100.0 } else { 180.0 };
-            if !(v.is_finite() && v.abs() <= limit) {
-                bail!("`{at}.mount.{name}` = {v}: allowed -{limit} ..= {limit}");
-            }
-            *slot = v;
+/// [`DatasetConfig`] as [`DatasetConfig::canonical`] writes it.
+#[derive(Serialize)]
+struct CanonicalConfig<'a> {
+    name: &'a str,
+    split: &'a Option<Split>,
+    sequences: Vec<CanonicalSequence<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    generate: &'a Option<super::generate::Generate>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    train: &'a Option<super::generate::TrainSection>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    weather: &'a Option<sim::effects::weather::Weather>,
+}
+
+/// A mount override's values, every field written (`null` when unset).
+#[derive(Serialize)]
+struct CanonicalMount {
+    x_m: Option<f32>,
+    y_m: Option<f32>,
+    z_m: Option<f32>,
+    roll_deg: Option<f32>,
+    pitch_deg: Option<f32>,
+    yaw_deg: Option<f32>,
+}
+
+/// A sequence in its canonical shape (see [`DatasetConfig::canonical`]).
+#[derive(Serialize)]
+struct CanonicalSequence<'a> {
+    id: u32,
+    scene: &'a str,
+    seed: u64,
+    rig: &'a str,
+    mount: Option<CanonicalMount>,
+    frames: u64,
+    speed_m_per_s: f64,
+    yaw_rate_deg_per_s: f64,
+    waypoints_m: &'a Option<Vec<[f64; 2]>>,
+    formats: &'a [String],
+    ideal: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    noise_scale: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dropout: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    intensity_scale: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    weather: Option<sim::effects::weather::Weather>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    family: &'a Option<String>,
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    params: &'a std::collections::BTreeMap<String, groundtruth_scenario::ParamValue>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mount_sensor: Option<&'a groundtruth_scenario::MountTarget>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mount_mode: Option<groundtruth_scenario::MountMode>,
+}
+
+impl<'a> CanonicalSequence<'a> {
+    fn of(s: &'a SequenceConfig) -> Self {
+        let spec = &s.spec;
+        let mount = spec.mount.as_ref();
+        CanonicalSequence {
+            id: s.id,
+            scene: &spec.scene,
+            seed: spec.seed,
+            rig: &spec.rig,
+            mount: mount.map(|m| CanonicalMount {
+                x_m: m.x_m,
+                y_m: m.y_m,
+                z_m: m.z_m,
+                roll_deg: m.roll_deg,
+                pitch_deg: m.pitch_deg,
+                yaw_deg: m.yaw_deg,
+            }),
+            frames: spec.frames,
+            speed_m_per_s: spec.speed_m_per_s,
+            yaw_rate_deg_per_s: spec.yaw_rate_deg_per_s,
+            waypoints_m: &spec.waypoints_m,
+            formats: &s.formats,
+            ideal: spec.ideal,
+            noise_scale: spec.noise_scale,
+            dropout: spec.dropout,
+            intensity_scale: spec.intensity_scale,
+            weather: spec.weather,
+            family: &spec.family,
+            params: &spec.params,
+            mount_sensor: mount.and_then(|m| m.sensor.as_ref()),
+            mount_mode: mount.map(|m| m.mode).filter(|m| *m != groundtruth_scenario::MountMode::Absolute),
         }
     }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -298,6 +299,20 @@ mod tests {
     }
 
     const ONE: &str = "[[sequences]]\nid = 3\nscene = \"flat\"\nrig = \"vlp16-roof\"\nframes = 2\n";
+
+    #[test]
+    fn the_canonical_form_is_the_one_before_scan_specs() {
+        // The id of a dataset written before sequences were scan specs (the same text then).
+        let c = parse(&format!("{ONE}mount = {{ z_m = 2.0, pitch_deg = 2.0 }}\nspeed_m_per_s = 8.0\ndropout = 0.05\n"))
+            .unwrap();
+        assert_eq!(
+            c.canonical(),
+            "{\"name\":\"groundtruth-dataset\",\"split\":null,\"sequences\":[{\"id\":3,\"scene\":\"flat\",\"seed\":0,\
+             \"rig\":\"vlp16-roof\",\"mount\":{\"x_m\":null,\"y_m\":null,\"z_m\":2.0,\"roll_deg\":null,\
+             \"pitch_deg\":2.0,\"yaw_deg\":null},\"frames\":2,\"speed_m_per_s\":8.0,\"yaw_rate_deg_per_s\":0.0,\
+             \"waypoints_m\":null,\"formats\":[],\"ideal\":false,\"dropout\":0.05}]}"
+        );
+    }
 
     #[test]
     fn a_minimal_file_and_its_defaults() {
@@ -327,13 +342,21 @@ mod tests {
     }
 
     #[test]
-    fn mount_overrides_apply_to_one_sensor_rigs_only() {
-        let mut rig = sim::Rig::load("vlp16-roof").unwrap();
-        apply_mount(&mut rig, &MountOverride { z_m: Some(2.5), ..Default::default() }, "s").unwrap();
+    fn the_spec_refusals_are_the_scan_specs() {
+        // The same message as `scan --spec`, the scenario builder and Python give.
+        for (extra, needle) in [
+            ("yaw_rate = 0.3\n", "invalid value for `yaw_rate`"),
+            ("mount = { z_m = 150.0 }\n", "invalid value for `mount.z_m`: 150 (allowed: -100 ..= 100)"),
+            ("colour = 1\n", "unknown field `colour`"),
+        ] {
+            let e = format!("{:#}", parse(&format!("{ONE}{extra}")).unwrap_err());
+            assert!(e.contains(needle), "{extra}: {e}");
+        }
+        let c = parse(&format!("{ONE}mount = {{ z_m = 2.5 }}\n")).unwrap();
+        let rig = c.sequences[0].spec.rig().unwrap();
         assert_eq!(rig.sensors[0].mount.z_m, 2.5);
-        let e = apply_mount(&mut rig, &MountOverride { z_m: Some(f32::NAN), ..Default::default() }, "s").unwrap_err();
-        assert!(e.to_string().contains("mount.z_m"));
-        let mut four = sim::Rig::load("lux-roof-4").unwrap();
-        assert!(apply_mount(&mut four, &MountOverride::default(), "s").is_err());
+        let four = ONE.replace("vlp16-roof", "lux-roof-4");
+        let c = parse(&format!("{four}mount = {{ z_m = 2.5 }}\n")).unwrap();
+        assert!(c.sequences[0].spec.rig().unwrap_err().to_string().contains("mount.sensor"));
     }
 }

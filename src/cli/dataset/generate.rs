@@ -28,7 +28,9 @@ use anyhow::bail;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
-use super::config::{MountOverride, SequenceConfig};
+use groundtruth_scenario::{MountOverride, ScanSpec};
+
+use super::config::SequenceConfig;
 
 /// The `[generate]` table.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -165,20 +167,19 @@ impl Generate {
             };
             out.push(SequenceConfig {
                 id: first_id + k as u32,
-                scene,
-                seed,
-                rig,
-                mount,
-                frames: self.frames,
-                speed_m_per_s: speed,
-                yaw_rate_deg_per_s: 0.0,
-                waypoints_m: None,
+                spec: ScanSpec {
+                    scene,
+                    seed,
+                    rig,
+                    mount,
+                    frames: self.frames,
+                    speed_m_per_s: speed,
+                    noise_scale,
+                    dropout,
+                    intensity_scale,
+                    ..ScanSpec::default()
+                },
                 formats: Vec::new(),
-                ideal: false,
-                noise_scale,
-                dropout,
-                intensity_scale,
-                weather: None,
             });
         }
         Ok(out)
@@ -219,7 +220,7 @@ mod tests {
         pairs.dedup();
         assert_eq!(pairs.len(), 6, "3 scenes x 2 rigs");
         for s in &a {
-            let m = s.mount.unwrap();
+            let m = s.mount.clone().unwrap();
             assert!((1.4..=2.4).contains(&m.z_m.unwrap()) && (-3.0..=3.0).contains(&m.pitch_deg.unwrap()));
             assert!(m.roll_deg.is_none());
             assert!((0.0..=0.1).contains(&s.dropout.unwrap()));

@@ -6,12 +6,13 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use glam::{DAffine3, DQuat, EulerRot};
+use groundtruth_scenario::{ScanBackend, ScanSpec};
 use rayon::prelude::*;
 use sim::io::atomic::write_bytes_atomic;
 use sim::motion::{Trajectory, VehiclePose};
 use sim::scan::{ScanConfig, Scanner};
 
-use super::config::{DatasetConfig, SequenceConfig, apply_mount};
+use super::config::{DatasetConfig, SequenceConfig};
 use crate::cli::shard::{Shard, stable_key};
 
 /// Manifest file name in the dataset root.
@@ -36,29 +37,9 @@ pub(crate) fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
     let mut out = Vec::with_capacity(config.sequences.len());
     for (k, s) in config.sequences.iter().enumerate() {
         let at = format!("sequences[{k}]");
-        let scene = crate::cli::common::load_scene_full(&s.scene, s.seed).with_context(|| format!("`{at}.scene`"))?;
-        let mut rig = crate::cli::common::load_rig(&s.rig).with_context(|| format!("`{at}.rig`"))?;
-        if let Some(m) = &s.mount {
-            apply_mount(&mut rig, m, &at)?;
-        }
-        if let Some(scale) = s.noise_scale {
-            for sensor in &mut rig.sensors {
-                let sigma = sensor.spec.measurement().range_sigma_m;
-                sensor.spec.measurement_params_mut().range_sigma_m = Some(sigma * scale as f32);
-            }
-        }
-        let scan = ScanConfig {
-            seed: s.seed,
-            frames: s.frames as usize,
-            speed_m_per_s: s.speed_m_per_s as f32,
-            yaw_rate_rad_per_s: s.yaw_rate_deg_per_s.to_radians() as f32,
-            ideal: s.ideal,
-            ego_z_m: scene.ego_ground_z_m,
-            waypoints_m: s.waypoints_m.clone().unwrap_or_default(),
-            weather: s.weather.or(scene.weather),
-            ..ScanConfig::default()
-        };
-        scan.validate().with_context(|| format!("`{at}`"))?;
+        let scene = s.spec.load_scene().with_context(|| format!("`{at}.scene`"))?;
+        let setup = s.spec.setup(&scene).with_context(|| format!("`{at}`"))?;
+        let (rig, scan) = (setup.rig, setup.config);
         let period_s = frame_period_s(&rig)?;
         check_inside(&scene.mesh, &scan, period_s, &at)?;
         out.push(Prepared { config: s.clone(), rig, scan });
@@ -69,14 +50,7 @@ pub(crate) fn prepare(config: &DatasetConfig) -> anyhow::Result<Vec<Prepared>> {
 /// Applies a sequence's random dropout and intensity scale to frame `k` (its noise scale is in
 /// the rig already).
 pub(crate) fn vary(cloud: &mut sim::OrderedCloud, s: &SequenceConfig, k: usize) -> anyhow::Result<()> {
-    if let Some(p) = s.dropout {
-        // The scan's own seed, on a stream of its own (Purpose::Dropout).
-        sim::effects::variation::drop_returns(cloud, p as f32, s.seed, k as u32)?;
-    }
-    if let Some(scale) = s.intensity_scale {
-        sim::effects::variation::scale_intensity(cloud, scale as f32)?;
-    }
-    Ok(())
+    Ok(s.spec.vary(cloud, k)?)
 }
 
 /// The rig's frame period (its slowest sensor), seconds.
@@ -120,12 +94,17 @@ fn trajectory(scan: &ScanConfig) -> Trajectory {
 fn manifest(config: &DatasetConfig, prepared: &[Prepared]) -> anyhow::Result<serde_json::Value> {
     let mut sequences = Vec::new();
     for p in prepared {
+        let spec = ScanSpec { backend: Some(ScanBackend::from_sim(p.scan.backend)), ..p.config.spec.clone() };
         sequences.push(serde_json::json!({
             "id": p.config.id,
             "folder": format!("sequences/{:02}", p.config.id),
             "frames": p.config.frames,
             "frame_period_s": frame_period_s(&p.rig)?,
             "points_frame": if p.rig.sensors.len() == 1 { "sensor" } else { "vehicle" },
+            // Each sensor's mount as scanned (the override applied), for readers of the dataset.
+            "mounts": p.rig.sensors.iter().map(|s| s.mount).collect::<Vec<_>>(),
+            // The full description the sequence was scanned from.
+            "spec": spec,
         }));
     }
     Ok(serde_json::json!({
@@ -281,7 +260,7 @@ pub fn generate(
 fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bool) -> anyhow::Result<Counts> {
     let s = &p.config;
     let seq = out.join("sequences").join(format!("{:02}", s.id));
-    let scene = crate::cli::common::load_scene_full(&s.scene, s.seed)?;
+    let scene = s.spec.load_scene()?;
     let scanner = Scanner::new(&scene.mesh, &p.rig, p.scan.clone())?;
     let single = p.rig.sensors.len() == 1;
     let vehicle_from_sensor = p.rig.sensors[0].mount.vehicle_from_sensor();

@@ -70,6 +70,11 @@ struct RawSweep {
     sensor: BTreeMap<String, RawValues>,
     #[serde(default)]
     weather: Option<RawWeather>,
+    /// Keys without their unit: refused as a scan spec refuses them.
+    #[serde(default)]
+    speed: Option<serde::de::IgnoredAny>,
+    #[serde(default)]
+    yaw_rate: Option<serde::de::IgnoredAny>,
 }
 
 /// The sweep's weather: a list of specs or one kind with its parameter's values.
@@ -157,6 +162,11 @@ impl Sweep {
             }
             Ok(())
         };
+        for (key, given) in [("speed", raw.speed.is_some()), ("yaw_rate", raw.yaw_rate.is_some())] {
+            if given {
+                bail!("{source}: {}", groundtruth_scenario::spec::unitless_key(key));
+            }
+        }
         nonempty("scenes", &raw.scenes)?;
         nonempty("rigs", &raw.rigs)?;
         nonempty("methods", &raw.methods)?;
@@ -386,6 +396,8 @@ mod tests {
             ("[mount]\nz_m = [1.0, 1.0]\n", "twice"),
             ("frames = 0\n", "frames"),
             ("colour = 1\n", "colour"),
+            ("speed = 3.0\n", "invalid value for `speed`"),
+            ("yaw_rate = 0.3\n", "invalid value for `yaw_rate`"),
         ];
         for (extra, needle) in cases {
             let text = if extra.starts_with('[') { format!("{BASE}{extra}") } else { format!("{extra}{BASE}") };

@@ -6,9 +6,10 @@ use std::collections::HashSet;
 use anyhow::Context;
 use classifier::{Evaluation, FrameInput};
 use glam::Vec2;
+use groundtruth_scenario::ScanSetup;
 use serde_json::Value;
 use sim::OrderedCloud;
-use sim::scan::{PreparedScene, ScanConfig, Scanner};
+use sim::scan::{PreparedScene, Scanner};
 
 use super::expand::{Configuration, Space};
 use super::results::{bands, num};
@@ -83,16 +84,7 @@ pub fn evaluate(
 ) -> anyhow::Result<Vec<Vec<Value>>> {
     let sweep = &space.sweep;
     let seed = sweep.seeds[c.seed];
-    let rig = space.rig(c)?;
-    let config = ScanConfig {
-        seed,
-        frames: sweep.frames,
-        speed_m_per_s: sweep.speed_m_per_s,
-        ideal: sweep.ideal,
-        ego_z_m: scene.ego_ground_z_m,
-        weather: space.weather(c)?.or(scene.weather),
-        ..Default::default()
-    };
+    let ScanSetup { config, rig } = space.spec(c)?.setup_with_rig(scene, space.sensor_rig(c)?)?;
     let scanner = Scanner::with_prepared(&scene.mesh, &rig, config, prepared).context("setting up the scan")?;
     let body: Vec<&sim::rig::MountedSensor> =
         rig.sensors.iter().filter(|s| sweep.body == "rig" || s.name == sweep.body).collect();

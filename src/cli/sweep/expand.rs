@@ -2,7 +2,9 @@
 //! numbered `0 .. count` in mixed radix (the last axis varies fastest), decoded on demand so
 //! nothing proportional to the count is held in memory.
 //!
-//! A configuration's parameters are applied to its rig:
+//! Each configuration is a `groundtruth_scenario::ScanSpec` ([`Space::spec`]); its mount values are
+//! the spec's mount override (`sensor` = the body, `absolute`), checked against the one set of
+//! mount limits. A configuration's parameters are applied to its rig:
 //! - `body = "<sensor>"`: the mount values replace that sensor's `mount` fields (absolute, as in
 //!   the manifest) and the sensor values its `spec` fields;
 //! - `body = "rig"` (default): the whole rig moves as one rigid body. Its reference point is the
@@ -16,7 +18,7 @@
 //! machine.
 
 use anyhow::{Context, bail};
-use glam::{EulerRot, Quat, Vec3};
+use groundtruth_scenario::{MountOverride, MountTarget, ScanSpec};
 use sim::Rig;
 
 use super::config::{MAX_CONFIGURATIONS, Sweep};
@@ -177,44 +179,83 @@ impl Space {
         Ok(Some(sim::effects::weather::Weather::parse(&spec)?))
     }
 
-    /// The rig of configuration `c`.
-    pub fn rig(&self, c: &Configuration) -> anyhow::Result<Rig> {
+    /// The scan spec of configuration `c`: its scene, seed, rig, the mount override its mount
+    /// values make (on `body`), frames, speed and weather. Its rig's sensor values are applied to
+    /// the base rig by [`Space::sensor_rig`].
+    pub fn spec(&self, c: &Configuration) -> anyhow::Result<ScanSpec> {
         let values: Vec<Option<usize>> = c.values.iter().map(|&k| Some(k)).collect();
-        self.apply(&self.rigs[c.rig], &values)
+        Ok(ScanSpec {
+            scene: self.sweep.scenes[c.scene].clone(),
+            seed: self.sweep.seeds[c.seed],
+            rig: self.sweep.rigs[c.rig].clone(),
+            mount: Some(self.mount(&values)?),
+            frames: self.sweep.frames as u64,
+            speed_m_per_s: f64::from(self.sweep.speed_m_per_s),
+            ideal: self.sweep.ideal,
+            weather: self.weather(c)?,
+            ..ScanSpec::default()
+        })
+    }
+
+    /// The base rig of configuration `c` with its sensor values (not its mount values) applied.
+    pub fn sensor_rig(&self, c: &Configuration) -> anyhow::Result<Rig> {
+        let values: Vec<Option<usize>> = c.values.iter().map(|&k| Some(k)).collect();
+        self.with_sensor_values(&self.rigs[c.rig], &values)
+    }
+
+    /// The rig of configuration `c` (the sweep scans through [`Space::spec`]).
+    #[cfg(test)]
+    pub fn rig(&self, c: &Configuration) -> anyhow::Result<Rig> {
+        Ok(self.spec(c)?.rig_from(self.sensor_rig(c)?)?)
+    }
+
+    /// The mount override of the given axis values (`None`: left as designed) on `body`.
+    fn mount(&self, values: &[Option<usize>]) -> anyhow::Result<MountOverride> {
+        let sensor = match self.sweep.body.as_str() {
+            "rig" => MountTarget::rig(),
+            name => MountTarget::Name(name.to_string()),
+        };
+        let mut o = MountOverride { sensor: Some(sensor), ..MountOverride::default() };
+        for (axis, k) in self.sweep.axes().zip(values) {
+            let Some(k) = *k else { continue };
+            let v = || axis.values[k].as_f64().context("mount values are numbers").map(|v| Some(v as f32));
+            match axis.name.as_str() {
+                "x_m" => o.x_m = v()?,
+                "y_m" => o.y_m = v()?,
+                "z_m" => o.z_m = v()?,
+                "roll_deg" => o.roll_deg = v()?,
+                "pitch_deg" => o.pitch_deg = v()?,
+                "yaw_deg" => o.yaw_deg = v()?,
+                _ => {}
+            }
+        }
+        Ok(o)
     }
 
     /// `base` with the given axis values (`None`: left as designed) applied, validated.
     fn apply(&self, base: &Rig, values: &[Option<usize>]) -> anyhow::Result<Rig> {
+        let mut rig = self.with_sensor_values(base, values)?;
+        self.mount(values)?.apply_to_rig(&mut rig)?;
+        Ok(rig)
+    }
+
+    /// `base` with the sensor values of the given axes applied (to `body`, or every sensor of the
+    /// rig), validated.
+    fn with_sensor_values(&self, base: &Rig, values: &[Option<usize>]) -> anyhow::Result<Rig> {
         let mut rig = base.clone();
-        let mut mount = [None::<f32>; 6];
         let mut sensor: Vec<(&str, &serde_json::Value)> = Vec::new();
         for (axis, k) in self.sweep.axes().zip(values) {
             let Some(k) = *k else { continue };
-            let v = &axis.values[k];
-            if axis.name.split('.').next() == Some(super::config::WEATHER_AXIS) {
+            let first = axis.name.split('.').next();
+            if first == Some(super::config::WEATHER_AXIS) || super::config::MOUNT_PARAMS.contains(&axis.name.as_str()) {
                 continue;
             }
-            if let Some(p) = super::config::MOUNT_PARAMS.iter().position(|&m| m == axis.name) {
-                mount[p] = Some(v.as_f64().context("mount values are numbers")? as f32);
-            } else {
-                sensor.push((axis.name.trim_start_matches("sensor."), v));
-            }
+            sensor.push((axis.name.trim_start_matches("sensor."), &axis.values[k]));
         }
         let targets: Vec<usize> = if self.sweep.body == "rig" {
-            move_body(&mut rig, mount);
             (0..rig.sensors.len()).collect()
         } else {
-            let i = rig.sensors.iter().position(|s| s.name == self.sweep.body).context("body sensor")?;
-            let m = &mut rig.sensors[i].mount;
-            for (field, v) in [&mut m.x_m, &mut m.y_m, &mut m.z_m, &mut m.roll_deg, &mut m.pitch_deg, &mut m.yaw_deg]
-                .into_iter()
-                .zip(mount)
-            {
-                if let Some(v) = v {
-                    *field = v;
-                }
-            }
-            vec![i]
+            vec![rig.sensors.iter().position(|s| s.name == self.sweep.body).context("body sensor")?]
         };
         if !sensor.is_empty() {
             for &i in &targets {
@@ -247,35 +288,6 @@ fn set_path(spec: &mut serde_json::Value, path: &str, v: serde_json::Value) {
             return;
         }
         node = obj.entry(p.to_string()).or_insert_with(|| serde_json::json!({}));
-    }
-}
-
-/// Moves the whole rig as one body (see the module doc): `mount` holds the new reference point
-/// (x, y, z; `None` keeps it) and the body's roll, pitch, yaw relative to the design.
-fn move_body(rig: &mut Rig, mount: [Option<f32>; 6]) {
-    let n = rig.sensors.len().max(1) as f32;
-    let origin =
-        rig.sensors.iter().map(|s| Vec3::new(s.mount.x_m, s.mount.y_m, s.mount.z_m)).fold(Vec3::ZERO, |a, b| a + b) / n;
-    let target = Vec3::new(mount[0].unwrap_or(origin.x), mount[1].unwrap_or(origin.y), mount[2].unwrap_or(origin.z));
-    let (roll, pitch, yaw) = (mount[3].unwrap_or(0.0), mount[4].unwrap_or(0.0), mount[5].unwrap_or(0.0));
-    let turned = roll != 0.0 || pitch != 0.0 || yaw != 0.0;
-    let body = Quat::from_euler(EulerRot::ZYX, yaw.to_radians(), pitch.to_radians(), roll.to_radians());
-    for s in &mut rig.sensors {
-        let m = &mut s.mount;
-        let p = Vec3::new(m.x_m, m.y_m, m.z_m) - origin;
-        let p = target + if turned { body * p } else { p };
-        (m.x_m, m.y_m, m.z_m) = (p.x, p.y, p.z);
-        if turned {
-            let q = body
-                * Quat::from_euler(
-                    EulerRot::ZYX,
-                    m.yaw_deg.to_radians(),
-                    m.pitch_deg.to_radians(),
-                    m.roll_deg.to_radians(),
-                );
-            let (z, y, x) = q.to_euler(EulerRot::ZYX);
-            (m.yaw_deg, m.pitch_deg, m.roll_deg) = (z.to_degrees(), y.to_degrees(), x.to_degrees());
-        }
     }
 }
 
@@ -357,7 +369,7 @@ mod tests {
             };
             assert!(e.contains(needle), "{extra}: {e}");
         };
-        bad("[mount]\nz_m = [200.0]\n", "z_m");
+        bad("[mount]\nz_m = [200.0]\n", "invalid value for `mount.z_m`: 200 (allowed: -100 ..= 100)");
         bad("[sensor]\nfrequency_hz = [13.0]\n", "frequency_hz");
         bad("[sensor]\ncolumns = [1024]\n", "columns");
         bad("body = \"roof_9\"\n", "roof_9");
