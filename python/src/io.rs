@@ -6,13 +6,16 @@ use std::sync::Arc;
 use classifier::recording::{Ordering, Recording, RecordingError, read_as_stored};
 use groundtruth_scenario::Scan;
 use pyo3::prelude::*;
+use sim::io::formats::Format;
 use sim::io::pcd::PcdLayout;
 
 use crate::error::{sim_error, type_error, value_error};
 use crate::frame::Frame;
 
-/// The formats `write` takes.
-pub const WRITE_FORMATS: [&str; 6] = ["pcd", "pcd-ascii", "ply", "kitti", "las", "mcap"];
+/// The formats `write` takes (those of `groundtruth scan --format` this build writes).
+pub fn write_formats() -> Vec<&'static str> {
+    Format::available_names()
+}
 
 /// The lower-case extension of `path` (empty without one).
 fn extension(path: &Path) -> String {
@@ -172,23 +175,17 @@ pub fn write(
         .map_err(|_| type_error("frame", "expected a Frame (a list only with format=\"mcap\")"))?
         .borrow();
     let format = match format {
-        Some(f) => f.to_ascii_lowercase(),
-        None => match extension(&path).as_str() {
-            "pcd" => "pcd".into(),
-            "ply" => "ply".into(),
-            "bin" => "kitti".into(),
-            "las" => "las".into(),
-            e => {
-                return Err(value_error(
+        Some(f) => Format::parse_field(f, "format").map_err(|e| value_error("format", format!("`{f}`: {e}")))?,
+        None => {
+            let e = extension(&path);
+            Format::from_extension(&e).filter(|f| *f != Format::Mcap).ok_or_else(|| {
+                value_error(
                     "format",
-                    format!("none given and the extension `.{e}` names none (allowed: {})", WRITE_FORMATS.join(", ")),
-                ));
-            }
-        },
+                    format!("none given and the extension `.{e}` names none (allowed: {})", write_formats().join(", ")),
+                )
+            })?
+        }
     };
-    if !WRITE_FORMATS.contains(&format.as_str()) {
-        return Err(value_error("format", format!("`{format}` (allowed: {})", WRITE_FORMATS.join(", "))));
-    }
     let scan = frame.scan.clone();
     let k = frame.k;
     py.detach(move || -> Result<usize, sim::SimError> {
@@ -196,25 +193,8 @@ pub fn write(
         let rig = scan.rig();
         let sensor_from_vehicle =
             (rig.sensors.len() == 1).then(|| rig.sensors[0].mount.vehicle_from_sensor().inverse());
-        match format.as_str() {
-            "pcd" | "pcd-ascii" => {
-                sim::io::pcd::write_layout(&path, cloud, layout, format == "pcd-ascii", sensor_from_vehicle.as_ref())
-            }
-            "ply" => sim::io::ply::write(&path, cloud),
-            "las" => sim::io::las::write(&path, cloud),
-            _ => {
-                let (bin, label, n) = sim::io::kitti::encode(cloud, sensor_from_vehicle.as_ref())?;
-                sim::io::atomic::write_bytes_atomic(&path, &bin)?;
-                sim::io::atomic::write_bytes_atomic(&path.with_extension("label"), &label)?;
-                if let Some(t) = sensor_from_vehicle {
-                    let calib = sim::io::kitti::calib_text(&t.inverse());
-                    let stem = path.with_extension("");
-                    let calib_path = PathBuf::from(format!("{}.calib.txt", stem.display()));
-                    sim::io::atomic::write_bytes_atomic(&calib_path, calib.as_bytes())?;
-                }
-                Ok(n)
-            }
-        }
+        let files = sim::io::formats::write_file(&path, cloud, format, layout, sensor_from_vehicle.as_ref())?;
+        Ok(files.first().map_or(0, |f| f.points))
     })
     .map_err(sim_error)
 }

@@ -192,7 +192,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RIGS", sim::rig::PRESETS.to_vec())?;
     m.add("METHODS", classifier::METHODS.to_vec())?;
     m.add("REGIONS", score::REGIONS.to_vec())?;
-    m.add("WRITE_FORMATS", io::WRITE_FORMATS.to_vec())?;
+    m.add("WRITE_FORMATS", io::write_formats())?;
     m.add_class::<Frame>()?;
     m.add_class::<score::Score>()?;
     m.add_function(wrap_pyfunction!(scan, m)?)?;

@@ -57,6 +57,16 @@ impl Format {
         }
     }
 
+    /// Whether this build writes the format (LAZ needs the `laz` cargo feature).
+    pub fn available(self) -> bool {
+        self != Format::Laz || cfg!(feature = "laz")
+    }
+
+    /// The names of the formats this build writes, in [`Format::ALL`]'s order.
+    pub fn available_names() -> Vec<&'static str> {
+        Format::ALL.into_iter().filter(|f| f.available()).map(Format::name).collect()
+    }
+
     /// The extension of the frame's main file (`bin` for KITTI; `mcap` for the bag's file).
     pub fn extension(self) -> &'static str {
         match self {

@@ -300,11 +300,8 @@ fn write_sequence(p: &Prepared, out: &Path, shard: Shard, first: u64, resume: bo
         write_bytes_atomic(&seq.join("velodyne").join(format!("{stem}.bin")), &bin_bytes)?;
         for f in s.formats.iter().filter(|f| *f != "mcap") {
             let path = seq.join(f).join(format!("{stem}.{f}"));
-            match f.as_str() {
-                "pcd" => sim::io::pcd::write(&path, &frame.cloud, false).map(|_| ())?,
-                "ply" => sim::io::ply::write(&path, &frame.cloud).map(|_| ())?,
-                _ => sim::io::las::write_with(&path, &frame.cloud, false).map(|_| ())?,
-            }
+            let format = sim::io::formats::Format::parse_field(f, "formats")?;
+            sim::io::formats::write_file(&path, &frame.cloud, format, sim::io::pcd::PcdLayout::Groundtruth, None)?;
         }
         // Last: the frame is complete once its `.label` exists.
         write_bytes_atomic(&seq.join("labels").join(format!("{stem}.label")), &label_bytes)?;
