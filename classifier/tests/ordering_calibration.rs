@@ -85,7 +85,7 @@ fn bad_calibrations_are_refused_naming_the_file() {
             "num_lasers 64",
         ),
         ("h.toml", "[[lasers]]\nelevation_deg = 1.0\nspeed = 3\n", None, "unknown field"),
-        ("i.csv", "1\n2\n", None, "unknown extension"),
+        ("i.xls", "1\n2\n", None, "unknown extension"),
         ("j.txt", "1.0 2.0 3.0\n0.0\n", None, "line 1"),
     ];
     for (name, text, expected, want) in cases {

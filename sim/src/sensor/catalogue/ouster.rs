@@ -74,6 +74,7 @@ pub const OS0_128_ELEVATION_DEG: [f64; 128] = [
 ];
 /// OS0-128 beam azimuths by channel, degrees (positive clockwise).
 #[rustfmt::skip]
+#[allow(clippy::approx_constant)] // published angles in degrees (3.14, -6.28), not pi
 pub const OS0_128_AZIMUTH_OFFSET_DEG: [f64; 128] = [
     10.85, 3.67, -3.4, -10.32, 10.43, 3.53, -3.27, -9.99,
     10.08, 3.4, -3.18, -9.7, 9.77, 3.29, -3.1, -9.44,

@@ -133,6 +133,7 @@ pub const VLP32C: CatalogueEntry = CatalogueEntry {
 
 /// VLS-128 elevations by laser id, degrees (-25 ..= +15, non-uniform).
 #[rustfmt::skip]
+#[allow(clippy::approx_constant)] // published angles in degrees (3.14, -6.28), not pi
 pub const VLS128_ELEVATION_DEG: [f64; 128] = [
     -11.742, -1.99, 3.4, -5.29, -0.78, 4.61, -4.08, 1.31,
     -6.5, -1.11, 4.28, -4.41, 0.1, 6.48, -3.2, 2.19,
