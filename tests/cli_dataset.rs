@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 mod common;
 
-use common::{err, ok, run, s};
+use common::{err, files, ok, run, s};
 
 /// A fresh scratch directory for this file's test `name`.
 fn tmp(name: &str) -> PathBuf {
@@ -39,23 +39,6 @@ frames = 4
 speed_m_per_s = 10.0
 yaw_rate_deg_per_s = 20.0
 "#;
-
-/// Every file under `dir` (relative path -> bytes).
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
-}
 
 fn generate(config: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["dataset", "--config", s(config), "--out", s(out)];

@@ -4,33 +4,15 @@
 //! on stderr); an unknown key, a key without its unit and a mount outside the one set of limits are
 //! refused with the same message by `scan --spec`, dataset files and sweep files, nothing written.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 mod common;
 
-use common::{err, ok, run, s};
+use common::{err, files, ok, run, s};
 
 /// A fresh scratch directory for this file's test `name`.
 fn tmp(name: &str) -> PathBuf {
     common::tmp("spec", name)
-}
-
-/// Every file under `dir` (relative path -> bytes).
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
 }
 
 fn manifest(dir: &Path) -> serde_json::Value {

@@ -72,10 +72,19 @@ struct SceneArgs {
     /// Turn measurement effects off.
     #[arg(long)]
     ideal: bool,
-    /// Write the scores to this JSON file.
+    #[command(flatten)]
+    report: ReportArgs,
+}
+
+/// What `eval scene` and `eval dataset` both take: where the scores go, how much is printed, and
+/// the model of the methods that take one.
+#[derive(clap::Args, Debug)]
+struct ReportArgs {
+    /// Write the scores to this JSON file (atomically; `eval dataset`: per frame too).
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Also print per-frame means and the breakdown by class and range band.
+    /// Also print the details: per-frame means and the breakdown by class and range band (`eval
+    /// dataset`: a line per frame).
     #[arg(long)]
     details: bool,
     /// Trained model file for `mcdaniel` or `learned` (`groundtruth train`; default: the bundled
@@ -121,15 +130,8 @@ struct DatasetModeArgs {
     /// Draw each frame's outcome per method into this folder (none by default).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write every number (per frame too) to this JSON file.
-    #[arg(long)]
-    json: Option<PathBuf>,
-    /// Also print a line per frame.
-    #[arg(long)]
-    details: bool,
-    /// Trained model file for `mcdaniel` or `learned` (default: the bundled model).
-    #[arg(long)]
-    model: Option<PathBuf>,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 /// The papers whose own evaluation `eval paper` runs.
@@ -236,9 +238,7 @@ impl LegacyArgs {
                 topic: self.topic,
                 max_frames: self.max_frames,
                 out: self.out,
-                json: self.json,
-                details: self.details,
-                model: self.model,
+                report: ReportArgs { json: self.json, details: self.details, model: self.model },
             }));
         }
         deprecated("--scene S --rig R", "scene --scene S --rig R");
@@ -256,9 +256,7 @@ impl LegacyArgs {
             seed: self.seed,
             speed_m_per_s: self.speed,
             ideal: self.ideal,
-            json: self.json,
-            details: self.details,
-            model: self.model,
+            report: ReportArgs { json: self.json, details: self.details, model: self.model },
         }))
     }
 }
@@ -281,10 +279,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ground: a.ground.as_deref(),
             sensor_height_m: a.sensor_height_m,
             max_frames: a.max_frames,
-            json: a.json.as_deref(),
+            json: a.report.json.as_deref(),
             out: a.out.as_deref(),
-            model: a.model.as_deref(),
-            details: a.details,
+            model: a.report.model.as_deref(),
+            details: a.report.details,
             topic: a.topic.as_deref(),
         }),
         Mode::Paper(a) => {
@@ -306,7 +304,7 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
     if names.is_empty() {
         anyhow::bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));
     }
-    if let Some(model) = &args.model
+    if let Some(model) = &args.report.model
         && !names.iter().any(|n| super::common::takes_model(n))
     {
         anyhow::bail!(
@@ -316,7 +314,7 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
     }
     // Refuse unknown names before scanning.
     for n in &names {
-        super::common::method(n, args.seed, args.model.as_deref().filter(|_| super::common::takes_model(n)))?;
+        super::common::method(n, args.seed, args.report.model.as_deref().filter(|_| super::common::takes_model(n)))?;
     }
     let frames = super::common::scan_spec(&groundtruth_scenario::ScanSpec {
         scene: scene_name.clone(),
@@ -332,7 +330,7 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
     let mut json: BTreeMap<String, Scores> = BTreeMap::new();
     for name in &names {
         let mut method =
-            super::common::method(name, args.seed, args.model.as_deref().filter(|_| super::common::takes_model(name)))?;
+            super::common::method(name, args.seed, args.report.model.as_deref().filter(|_| super::common::takes_model(name)))?;
         let mut eval = Evaluation::default();
         for f in &frames {
             let input = FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };
@@ -344,7 +342,7 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
             "{:<24} {:>7.4} {:>7.4} {:>9.4} {:>7.4} {:>7.4} {:>7.4}",
             name, s.acc, s.fpr, s.precision, s.recall, s.f1, s.iou
         );
-        if args.details {
+        if args.report.details {
             let m = eval.per_frame_mean();
             println!(
                 "  per-frame mean           {:>7.4} {:>7.4} {:>9.4} {:>7.4} {:>7.4} {:>7.4}",
@@ -373,7 +371,7 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
         }
         json.insert(name.clone(), s);
     }
-    if let Some(path) = &args.json {
+    if let Some(path) = &args.report.json {
         let text = serde_json::to_string_pretty(&serde_json::json!({ "methods": json }))?;
         sim::io::atomic::write_bytes_atomic(path, text.as_bytes())?;
     }
