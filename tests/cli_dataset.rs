@@ -198,9 +198,9 @@ fn shards_resume_and_threads_give_the_same_bytes() {
 fn bad_input_is_refused_before_anything_is_written() {
     let d = tmp("bad");
     let cases = [
-        (SMALL.replace("scene = \"flat\"\nseed = 4", "scene = \"mars\"\nseed = 4"), "unknown scene `mars`"),
-        (SMALL.replace("rig = \"vlp16-roof\"\nframes = 3", "rig = \"vlp99\"\nframes = 3"), "sequences[0].rig"),
-        (SMALL.replace("frames = 3", "frames = 0"), "sequences[0].frames"),
+        (SMALL.replace("scene = \"flat\"\nseed = 4", "scene = \"mars\"\nseed = 4"), "`scene`: `mars`"),
+        (SMALL.replace("rig = \"vlp16-roof\"\nframes = 3", "rig = \"vlp99\"\nframes = 3"), "vlp99"),
+        (SMALL.replace("frames = 3", "frames = 0"), "`sequences[0]`: invalid value for `frames`: 0"),
         (SMALL.replace("id = 7", "id = 0"), "duplicate"),
         (SMALL.replace("id = 7", "id = 100"), "sequences[1].id"),
         (format!("{SMALL}colour = 1\n"), "unknown field `colour`"),

@@ -290,19 +290,15 @@ mod tests {
 
     #[test]
     fn limits_name_the_field_and_range() {
-        for (name, lo, hi) in MOUNT_LIMITS {
-            let mut o = MountOverride::default();
-            let slot = match name {
-                "x_m" => &mut o.x_m,
-                "y_m" => &mut o.y_m,
-                "z_m" => &mut o.z_m,
-                "roll_deg" => &mut o.roll_deg,
-                "pitch_deg" => &mut o.pitch_deg,
-                _ => &mut o.yaw_deg,
+        for (k, (name, lo, hi)) in MOUNT_LIMITS.into_iter().enumerate() {
+            let with = |v: f32| {
+                let mut values = [None; 6];
+                values[k] = Some(v);
+                let [x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg] = values;
+                MountOverride { x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg, ..Default::default() }
             };
-            *slot = Some(hi);
-            assert!(o.validate().is_ok());
-            *slot = Some(hi + 1.0);
+            assert!(with(hi).validate().is_ok() && with(lo).validate().is_ok());
+            let o = with(hi + 1.0);
             let e = o.validate().unwrap_err().to_string();
             assert_eq!(e, format!("invalid value for `mount.{name}`: {} (allowed: {lo} ..= {hi})", hi + 1.0));
         }
