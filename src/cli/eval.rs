@@ -87,7 +87,8 @@ pub struct Args {
     /// Also print per-frame means and the breakdown by class and range band.
     #[arg(long)]
     details: bool,
-    /// Trained model file for `mcdaniel` (`groundtruth train`; default: the bundled forest model).
+    /// Trained model file for `mcdaniel` or `learned` (`groundtruth train`; default: the bundled
+    /// model), given to the methods of --methods that take one.
     #[arg(long, conflicts_with = "paper")]
     model: Option<PathBuf>,
 }
@@ -138,7 +139,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(model) = &args.model
         && !names.iter().any(|n| super::common::takes_model(n))
     {
-        anyhow::bail!("--model `{}` applies to `mcdaniel`, which --methods does not name", model.display());
+        anyhow::bail!(
+            "--model `{}` applies to `mcdaniel` and `learned`, which --methods does not name",
+            model.display()
+        );
     }
     // Refuse unknown names before scanning.
     for n in &names {
