@@ -88,7 +88,7 @@ struct ReportArgs {
     #[arg(long)]
     details: bool,
     /// Trained model file for `mcdaniel` or `learned` (`groundtruth train`; default: the bundled
-    /// model).
+    /// model), given to the methods of --methods that take one.
     #[arg(long)]
     model: Option<PathBuf>,
 }

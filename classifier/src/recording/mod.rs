@@ -21,7 +21,7 @@
 //! for (i, p) in cloud.point_in_vehicle.iter_mut().enumerate() {
 //!     *p = glam::Vec3::new(10.0, i as f32, -1.0);
 //! }
-//! sim::io::pcd::write(&dir.path().join("frame_000007.pcd"), &cloud)?;
+//! sim::io::pcd::write(&dir.path().join("frame_000007.pcd"), &cloud, false)?;
 //! let recording = Recording::open(dir.path(), None)?;
 //! let mut frames = recording.frames(Ordering::AsStored)?;
 //! let frame = frames.next_frame().expect("one frame")?;
