@@ -329,8 +329,11 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
     println!("{:<24} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}", "method", "acc", "FPR", "precision", "recall", "F1", "IoU");
     let mut json: BTreeMap<String, Scores> = BTreeMap::new();
     for name in &names {
-        let mut method =
-            super::common::method(name, args.seed, args.report.model.as_deref().filter(|_| super::common::takes_model(name)))?;
+        let mut method = super::common::method(
+            name,
+            args.seed,
+            args.report.model.as_deref().filter(|_| super::common::takes_model(name)),
+        )?;
         let mut eval = Evaluation::default();
         for f in &frames {
             let input = FrameInput { index: f.index, cloud: &f.cloud, world_from_vehicle: Some(f.world_from_vehicle) };

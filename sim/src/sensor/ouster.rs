@@ -53,17 +53,7 @@ fn validate_mode(field: &str, columns: u32, frequency_hz: f32) -> Result<()> {
 /// dropout beyond 89 deg, divergence 3 mrad (0.18 deg), one echo, echo separation 1 m, intensity
 /// reference 10 m.
 fn os1_measurement(params: &MeasurementParams) -> Measurement {
-    params.apply(Measurement {
-        min_range_m: 0.5,
-        max_range_m: 120.0,
-        range_sigma_m: 0.01,
-        range_quantum_m: 0.001,
-        max_incidence_deg: 89.0,
-        beam_divergence_rad: 0.003,
-        max_echoes: 1,
-        echo_separation_m: 1.0,
-        intensity_reference_m: 10.0,
-    })
+    params.apply(Measurement::spinning(0.5, 120.0, 0.01, 0.001))
 }
 
 /// Lasers of a uniform-elevation OS1 from the top channel down; returned bottom-up (row order).

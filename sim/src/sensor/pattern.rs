@@ -73,6 +73,24 @@ pub struct Measurement {
 }
 
 impl Measurement {
+    /// A spinning sensor's measurement from its range limits, range noise and range quantum, with
+    /// the figures every spinning model here shares (representative, not from a datasheet): grazing
+    /// returns beyond 89 deg dropped, 3 mrad beam divergence, one echo (a return mode with two
+    /// sets [`Measurement::max_echoes`]), 1 m echo separation, intensity saturating at 10 m.
+    pub const fn spinning(min_range_m: f32, max_range_m: f32, range_sigma_m: f32, range_quantum_m: f32) -> Self {
+        Self {
+            min_range_m,
+            max_range_m,
+            range_sigma_m,
+            range_quantum_m,
+            max_incidence_deg: 89.0,
+            beam_divergence_rad: 0.003,
+            max_echoes: 1,
+            echo_separation_m: 1.0,
+            intensity_reference_m: 10.0,
+        }
+    }
+
     /// This measurement with every effect off: exact distances, no noise, no quantisation,
     /// no grazing dropout, thin beam, one echo. Min / max range are kept.
     pub fn ideal(self) -> Self {

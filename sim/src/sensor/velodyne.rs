@@ -74,17 +74,7 @@ impl Vlp16Spec {
 
     /// The default measurement with overrides applied.
     pub fn measurement(&self) -> Measurement {
-        self.measurement.apply(Measurement {
-            min_range_m: 0.5,
-            max_range_m: 100.0,
-            range_sigma_m: 0.03,
-            range_quantum_m: 0.002,
-            max_incidence_deg: 89.0,
-            beam_divergence_rad: 0.003,
-            max_echoes: 1,
-            echo_separation_m: 1.0,
-            intensity_reference_m: 10.0,
-        })
+        self.measurement.apply(Measurement::spinning(0.5, 100.0, 0.03, 0.002))
     }
 }
 

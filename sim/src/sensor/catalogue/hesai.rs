@@ -36,17 +36,7 @@ pub(super) const NEBULA_DRIVER: DriverLayout = DriverLayout {
 /// Range noise, grazing dropout, divergence, echo separation and intensity reference are
 /// representative, not from a published file.
 const fn measurement(min_range_m: f32, max_range_m: f32, range_sigma_m: f32) -> Measurement {
-    Measurement {
-        min_range_m,
-        max_range_m,
-        range_sigma_m,
-        range_quantum_m: 0.004,
-        max_incidence_deg: 89.0,
-        beam_divergence_rad: 0.003,
-        max_echoes: 1,
-        echo_separation_m: 1.0,
-        intensity_reference_m: 10.0,
-    }
+    Measurement::spinning(min_range_m, max_range_m, range_sigma_m, 0.004)
 }
 
 /// Pandar64 elevations by laser id, degrees (+14.9 ..= -24.879).

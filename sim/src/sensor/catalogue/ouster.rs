@@ -39,17 +39,7 @@ const DRIVER: DriverLayout = DriverLayout {
 
 /// Range noise, quantum, divergence: the OS1 models' representative figures.
 const fn measurement(min_range_m: f32, max_range_m: f32) -> Measurement {
-    Measurement {
-        min_range_m,
-        max_range_m,
-        range_sigma_m: 0.01,
-        range_quantum_m: 0.001,
-        max_incidence_deg: 89.0,
-        beam_divergence_rad: 0.003,
-        max_echoes: 1,
-        echo_separation_m: 1.0,
-        intensity_reference_m: 10.0,
-    }
+    Measurement::spinning(min_range_m, max_range_m, 0.01, 0.001)
 }
 
 /// OS0-128 beam altitudes by channel, degrees (+44.30 ..= -46.16).

@@ -48,17 +48,7 @@ pub const HELIOS_5515: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: 55_560 },
     rates_hz: &[10.0, 20.0],
     default_rate_hz: 10.0,
-    measurement: Measurement {
-        min_range_m: 0.2,
-        max_range_m: 150.0,
-        range_sigma_m: 0.02,
-        range_quantum_m: 0.0025,
-        max_incidence_deg: 89.0,
-        beam_divergence_rad: 0.003,
-        max_echoes: 1,
-        echo_separation_m: 1.0,
-        intensity_reference_m: 10.0,
-    },
+    measurement: Measurement::spinning(0.2, 150.0, 0.02, 0.0025),
     return_modes: &[ReturnMode::Strongest, ReturnMode::Last, ReturnMode::Dual],
     driver: NEBULA_DRIVER,
 };

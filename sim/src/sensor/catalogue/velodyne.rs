@@ -31,17 +31,7 @@ const DRIVER: DriverLayout = DriverLayout {
 /// Measurement figures shared by the three models (range noise, grazing dropout, divergence,
 /// echo separation, intensity reference: representative, not from a published file).
 const fn measurement(min_range_m: f32, max_range_m: f32, range_sigma_m: f32, range_quantum_m: f32) -> Measurement {
-    Measurement {
-        min_range_m,
-        max_range_m,
-        range_sigma_m,
-        range_quantum_m,
-        max_incidence_deg: 89.0,
-        beam_divergence_rad: 0.003,
-        max_echoes: 1,
-        echo_separation_m: 1.0,
-        intensity_reference_m: 10.0,
-    }
+    Measurement::spinning(min_range_m, max_range_m, range_sigma_m, range_quantum_m)
 }
 
 /// Firing offsets of `N` lasers fired `per_group` at a time, `spacing_ns` between groups, with
