@@ -192,7 +192,6 @@ def scan(
     dropout: Optional[float] = None,
     intensity_scale: Optional[float] = None,
     weather: Optional[str] = None,
-    speed: Optional[float] = None,
 ) -> list[Frame]:
     """Scan ``scene`` (bundled name, built-in such as ``flat-objects``, family, ``.toml`` path or
     TOML text) with ``rig`` (preset, ``.toml`` path or TOML text). The keywords are a scan spec's

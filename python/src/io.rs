@@ -51,6 +51,8 @@ pub fn read<'py>(py: Python<'py>, path: PathBuf, topic: Option<String>) -> PyRes
 }
 
 /// The PointCloud2 messages of a bag's topic as Frames.
+// The reader's error names files, topics and messages; it is returned once per call, not in a loop.
+#[allow(clippy::result_large_err)]
 fn read_bag(py: Python<'_>, path: &Path, topic: Option<String>) -> PyResult<Vec<Frame>> {
     let p = path.to_path_buf();
     let (clouds, warnings) = py
@@ -89,6 +91,7 @@ fn frame_of(cloud: sim::OrderedCloud, name: &str) -> Frame {
 }
 
 /// Reads one point-cloud file (see [`read`]).
+#[allow(clippy::result_large_err)] // As `read_bag`: one error per call.
 fn read_file(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
     if !path.is_file() {
         return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!("path: {}: no such file", path.display())));

@@ -33,6 +33,9 @@ pub struct Cli {
     command: Command,
 }
 
+// Parsed once per run: the size of the largest variant (eval's three modes and the flat spellings
+// it still reads) costs nothing worth boxing it for.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 enum Command {
     /// The main job on a built-in default: scan, classify, score and draw (city, hdl64e-roof, nitsch).
