@@ -67,7 +67,7 @@ def test_speed_is_deprecated_but_works():
     with pytest.warns(DeprecationWarning, match="speed_m_per_s"):
         (old,) = gt.scan("flat", "vlp16-roof", speed=5.0, ideal=True)
     (new,) = gt.scan("flat", "vlp16-roof", speed_m_per_s=5.0, ideal=True)
-    assert np.array_equal(old.range_m, new.range_m, equal_nan=True)
+    assert np.array_equal(old.range, new.range, equal_nan=True)
 
 
 def test_the_builtin_scene_is_reachable():
