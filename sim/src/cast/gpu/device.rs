@@ -48,10 +48,22 @@ impl Gpu {
     }
 }
 
+/// The process's one wgpu instance, made on first use and never dropped.
+///
+/// Dropping the last instance unloads the Vulkan loader and with it the driver (`dlclose`); on
+/// NVIDIA's driver a thread of its own can still be running then, and the process crashed at exit
+/// (SIGSEGV after its output was complete, about one run in ten on an H200 with driver 580: the
+/// crashing thread's code was unmapped while the main thread was in `munmap`; see also
+/// gfx-rs/wgpu#8365). A static is never dropped, so the driver stays loaded until the process ends.
+fn instance() -> &'static wgpu::Instance {
+    static INSTANCE: std::sync::OnceLock<wgpu::Instance> = std::sync::OnceLock::new();
+    INSTANCE.get_or_init(|| wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env()))
+}
+
 /// The adapter wgpu's environment variables choose: `WGPU_ADAPTER_NAME` (a case-insensitive
 /// substring of the name) among the adapters of `WGPU_BACKEND`, else the default request.
 fn adapter() -> Result<wgpu::Adapter, GpuError> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let instance = instance();
     if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
         let want = name.to_lowercase();
         let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
