@@ -56,6 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         pcd_layout: "groundtruth".into(),
         bag_compression: "zstd".into(),
         weather: None,
+        snow_cover_m: None,
         threads: None,
         backend: "bvh".into(),
     };

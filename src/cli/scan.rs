@@ -11,7 +11,7 @@ use sim::io::manifest::{FrameEntry, MANIFEST_VERSION, Manifest, SensorEntry, mat
 use sim::scan::Scanner;
 
 /// The flags that describe the scan (refused beside `--spec`, which describes it whole).
-const SPEC_FLAGS: [&str; 11] = [
+const SPEC_FLAGS: [&str; 12] = [
     "scene",
     "rig",
     "seed",
@@ -22,6 +22,7 @@ const SPEC_FLAGS: [&str; 11] = [
     "yaw_rate",
     "ideal",
     "weather",
+    "snow_cover_m",
     "backend",
 ];
 
@@ -30,8 +31,8 @@ const SPEC_FLAGS: [&str; 11] = [
 pub struct Args {
     /// The whole scan as a spec file (TOML, see docs/scan-spec.md; a manifest's `spec` saved as
     /// TOML or JSON remakes its files). The flags that describe the scan (--scene, --rig, --seed,
-    /// --frames, --speed-m-per-s, --yaw-rate-deg-per-s, --ideal, --weather, --backend) are refused
-    /// beside it.
+    /// --frames, --speed-m-per-s, --yaw-rate-deg-per-s, --ideal, --weather, --snow-cover-m,
+    /// --backend) are refused beside it.
     #[arg(long, conflicts_with_all = SPEC_FLAGS)]
     pub spec: Option<PathBuf>,
     /// Scene name (see `groundtruth list`: bundled, built-in, families) or TOML scene file.
@@ -83,6 +84,10 @@ pub struct Args {
     /// Returns from the medium are labelled fog (150), rain (151) or snow (152).
     #[arg(long)]
     pub weather: Option<String>,
+    /// Snow lying on the ground, metres deep (0 < depth <= 1): the ground raised by it, labelled
+    /// terrain (72) with snow's reflectivity.
+    #[arg(long)]
+    pub snow_cover_m: Option<f64>,
     /// Chunk compression of the bag (`--format mcap`): `zstd` (level 1, as `ros2 bag record -s
     /// mcap` writes) or `none` (larger files, no compression work).
     #[arg(long, default_value = "zstd")]
@@ -126,6 +131,7 @@ impl Args {
             frames: self.frames as u64,
             ideal: self.ideal,
             weather: self.weather.as_deref().map(Weather::parse).transpose().context("--weather")?,
+            snow_cover_m: self.snow_cover_m,
             backend: Some(ScanBackend::parse(&self.backend).context("--backend")?),
             ..ScanSpec::default()
         };

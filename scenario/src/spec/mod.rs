@@ -19,6 +19,7 @@
 //! dropout = 0.05               # probability a return is lost, 0 ..= 0.9 (optional)
 //! intensity_scale = 0.8        # 0 ..= 10 (optional)
 //! weather = { kind = "fog", visibility_m = 50.0 }   # default: the scene file's [weather]
+//! snow_cover_m = 0.1           # snow lying on the ground, (0, 1] m deep (optional)
 //! backend = "bvh"              # bvh, parry or gpu (optional; default bvh)
 //! ```
 
@@ -164,6 +165,10 @@ pub struct ScanSpec {
     /// Weather per beam (`{ kind = "fog", visibility_m = 50 }`); default the scene file's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weather: Option<Weather>,
+    /// Snow lying on the ground, metres deep (`0 < depth <= 1`): every ground triangle raised
+    /// by it and labelled terrain with snow's reflectivity (`sim::scene::snow_cover`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snow_cover_m: Option<f64>,
     /// Ray casting backend (default `bvh`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<ScanBackend>,
@@ -198,6 +203,7 @@ impl Default for ScanSpec {
             noise_scale: None,
             dropout: None,
             intensity_scale: None,
+            snow_cover_m: None,
             weather: None,
             backend: None,
             yaw_rate: None,
@@ -359,6 +365,12 @@ impl ScanSpec {
         if let Some(w) = &self.weather {
             w.validate()?;
         }
+        if let Some(d) = self.snow_cover_m {
+            let max = f64::from(sim::scene::snow_cover::MAX_SNOW_COVER_M);
+            if !(d > 0.0 && d <= max) {
+                return Err(ScenarioError::invalid("snow_cover_m", d, format!("0 < depth <= {max}")));
+            }
+        }
         if let Some(m) = &self.mount {
             m.validate()?;
         }
@@ -390,7 +402,13 @@ impl ScanSpec {
     /// Generates the scene (load it once and [`ScanSpec::setup`] any number of scans of it, e.g.
     /// with a `sim::scan::PreparedScene` shared by a sweep's configurations).
     pub fn load_scene(&self) -> Result<LoadedScene> {
-        scene::load(self.scene_source()?, &self.params, self.seed)
+        let mut loaded = scene::load(self.scene_source()?, &self.params, self.seed)?;
+        if let Some(depth_m) = self.snow_cover_m {
+            self.validate()?;
+            // The vehicle rides on the snow: the scanner follows the surface it finds under it.
+            sim::scene::snow_cover::lay_snow_cover(&mut loaded.mesh, depth_m as f32);
+        }
+        Ok(loaded)
     }
 
     /// The spec's rig: the preset, file or TOML text, with the mount override and noise scale.

@@ -82,6 +82,8 @@ fn bad_specs_are_refused_naming_the_field_and_range() {
         ("dropout = 0.95\n", "`dropout`: 0.95 (allowed: 0 ..= 0.9)"),
         ("waypoints_m = [[0, 0]]\n", "waypoints_m"),
         ("backend = \"cuda\"\n", "unknown variant `cuda`"),
+        ("snow_cover_m = 0.0\n", "`snow_cover_m`: 0 (allowed: 0 < depth <= 1)"),
+        ("snow_cover_m = 1.5\n", "`snow_cover_m`: 1.5 (allowed: 0 < depth <= 1)"),
     ];
     for (extra, needle) in cases {
         let e = ScanSpec::from_toml_str(&format!("{base}{extra}"), "f").unwrap_err().to_string();
@@ -143,4 +145,26 @@ fn setup_makes_the_config_the_fields_say() {
     assert_eq!(setup.rig.sensors[0].mount.z_m, 2.0);
     let sigma = sim::Rig::preset("vlp16-roof").unwrap().sensors[0].spec.measurement().range_sigma_m;
     assert_eq!(setup.rig.sensors[0].spec.measurement().range_sigma_m, sigma * 2.0);
+}
+
+#[test]
+fn snow_cover_raises_the_ground_and_makes_it_snow_covered_terrain() {
+    let bare = ScanSpec { scene: "rural".into(), rig: "vlp16-roof".into(), frames: 1, ..Default::default() };
+    let snowy = ScanSpec { snow_cover_m: Some(0.15), ..bare.clone() };
+    let (a, b) = (bare.load_scene().unwrap().mesh, snowy.load_scene().unwrap().mesh);
+    assert_eq!(a.triangles, b.triangles);
+    let ground: Vec<usize> = (0..a.len()).filter(|&t| a.surfaces[t].class.is_ground()).collect();
+    assert!(ground.len() > 1000, "{} ground triangles", ground.len());
+    for t in 0..a.len() {
+        if a.surfaces[t].class.is_ground() {
+            assert_eq!(b.surfaces[t].class, sim::SemanticClass::TERRAIN);
+            assert_eq!(b.surfaces[t].reflectivity, sim::scene::snow_cover::SNOW_REFLECTIVITY);
+            for &v in &a.triangles[t] {
+                let dz = b.vertices[v as usize].z - a.vertices[v as usize].z;
+                assert!((dz - 0.15).abs() < 1e-4, "vertex {v} raised {dz}");
+            }
+        } else {
+            assert_eq!(b.surfaces[t], a.surfaces[t]);
+        }
+    }
 }

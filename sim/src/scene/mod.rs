@@ -6,6 +6,7 @@ mod class;
 mod mesh;
 pub mod ply;
 pub mod semantic_kitti;
+pub mod snow_cover;
 
 pub use class::SemanticClass;
 pub use mesh::{SceneMesh, Surface};
