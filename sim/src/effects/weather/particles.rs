@@ -189,7 +189,8 @@ pub fn bistatic_overlap(range_m: f64, divergence_rad: f64) -> f64 {
     let alpha = ((s * s + a * a - b * b) / (2.0 * s * a)).clamp(-1.0, 1.0).acos();
     let beta = ((s * s + b * b - a * a) / (2.0 * s * b)).clamp(-1.0, 1.0).acos();
     let kite = 0.5 * ((-s + a + b) * (s + a - b) * (s - a + b) * (s + a + b)).max(0.0).sqrt();
-    (a * a * alpha + b * b * beta - kite) / (std::f64::consts::PI * a * a)
+    // (Clamped: at tangency the three terms cancel to a rounding error of either sign.)
+    ((a * a * alpha + b * b * beta - kite) / (std::f64::consts::PI * a * a)).clamp(0.0, 1.0)
 }
 
 /// Floors on the ladder, from the detection threshold up by factors of sqrt(2).
