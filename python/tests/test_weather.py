@@ -26,17 +26,23 @@ def test_fog_returns_are_labelled_near_and_never_ground():
 
 
 def test_rain_and_snow_labels_region_and_determinism():
-    for spec, label in [("rain:rate_mm_h=20", RAIN), ("snow:rate_mm_h=1", SNOW)]:
-        a = gt.scan("highway", "vlp16-roof", seed=1, weather=spec)[0]
-        b = gt.scan("highway", "vlp16-roof", seed=1, weather=spec)[0]
-        mask = a.region("weather")
-        assert mask.sum() > 0
-        assert (a.label[mask] == label).all()
-        np.testing.assert_array_equal(a.xyz, b.xyz)
-        # Our segmenters rarely call particles ground.
-        decisions = gt.classify(a, "learned")
-        score = gt.score(a, decisions, "weather")
-        assert score.false_ground_rate < 0.05, score
+    # Snow of 3 mm/h shows flakes (a few per cent of the returns, docs/weather.md).
+    a = gt.scan("highway", "vlp16-roof", seed=1, weather="snow:rate_mm_h=3")[0]
+    b = gt.scan("highway", "vlp16-roof", seed=1, weather="snow:rate_mm_h=3")[0]
+    mask = a.region("weather")
+    assert mask.sum() > 0
+    assert (a.label[mask] == SNOW).all()
+    np.testing.assert_array_equal(a.xyz, b.xyz)
+    # Our segmenters rarely call particles ground.
+    decisions = gt.classify(a, "learned")
+    score = gt.score(a, decisions, "weather")
+    assert score.false_ground_rate < 0.05, score
+    # Rain of 20 mm/h: drops are too faint to be seen beyond the receiver's overlap (they only
+    # attenuate), the scan is still deterministic and never labels anything but rain as weather.
+    a = gt.scan("highway", "vlp16-roof", seed=1, weather="rain:rate_mm_h=20")[0]
+    b = gt.scan("highway", "vlp16-roof", seed=1, weather="rain:rate_mm_h=20")[0]
+    np.testing.assert_array_equal(a.xyz, b.xyz)
+    assert (a.label[a.region("weather")] == RAIN).all()
 
 
 @pytest.mark.parametrize(
@@ -45,7 +51,7 @@ def test_rain_and_snow_labels_region_and_determinism():
         ("fog:visibility_m=0.5", "visibility_m"),
         ("fog:visibility_m=nan", "visibility_m"),
         ("rain:rate_mm_h=-1", "rate_mm_h"),
-        ("snow:rate_mm_h=100", "0 ..= 20"),
+        ("snow:rate_mm_h=100", "0 ..= 5"),
         ("hail:rate_mm_h=1", "clear, fog, rain, snow"),
         ("fog:rate_mm_h=3", "visibility_m"),
     ],

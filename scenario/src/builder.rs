@@ -340,7 +340,7 @@ impl Scenario {
     /// Weather decided per beam (fog by visibility, rain and snow by rate; see
     /// [`sim::effects::weather`]), in place of the scene file's `[weather]` table. Returns from the
     /// medium are labelled fog, rain or snow and are never ground. Refused at [`Scenario::scan`] when
-    /// out of range (visibility 1 ..= 100000 m, rain 0 ..= 200 mm/h, snow 0 ..= 20 mm/h).
+    /// out of range (visibility 1 ..= 100000 m, rain 0 ..= 200 mm/h, snow 0 ..= 5 mm/h).
     ///
     /// ```
     /// use groundtruth_scenario::{Scenario, Weather};

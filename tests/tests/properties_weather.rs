@@ -48,8 +48,9 @@ type Bounds = [Option<f64>; 5];
 /// comments and docs/weather.md.
 // Worst of 40 cases (GT_PROPTEST_CASES=40, seed 0; fog 12, rain 17, snow 11 cases), in method
 // order: fog 0.444, 0.0015, 0.557, 0.029, 0.018; rain 0.458, 0.014, 0.496, 0.026, 0.057; snow
-// 0.566, 0.037, 0.965, 0.053, 0.085. nitsch and grid (the same cluster rules) are a known failure:
-// `nitsch_and_grid_lose_the_road_when_fog_cuts_the_far_ground`, `snow_clutter_breaks_nitsch_and_grid`.
+// 0.566, 0.037, 0.965, 0.053, 0.085 (snow and rain measured before their calibration, ten times
+// too thick). nitsch and grid (the same cluster rules) are a known failure in fog:
+// `nitsch_and_grid_lose_the_road_when_fog_cuts_the_far_ground`.
 const FOG_RECALL_DROP: Bounds = [None, Some(0.01), None, Some(0.05), Some(0.03)];
 const RAIN_RECALL_DROP: Bounds = [None, Some(0.05), None, Some(0.05), Some(0.08)];
 const SNOW_RECALL_DROP: Bounds = [None, Some(0.06), None, Some(0.08), Some(0.12)];
@@ -206,13 +207,15 @@ fn nitsch_and_grid_lose_the_road_when_fog_cuts_the_far_ground() {
     assert!(clear - fog < 0.03, "{clear} -> {fog}");
 }
 
-/// Known failure: snow returns scattered over the grid cut the ground's clusters into pieces, and
-/// nitsch and grid reject most of the road: nitsch 0.947 -> 0.379 on `city` (seed 15402, 4.7
-/// mm/h), grid 0.965 -> 0.0 on `highway` (seed 109, 5 mm/h).
+/// Snow calibrated on measured snowfall (docs/weather.md) is a few per cent of the returns, not
+/// the 30-70 % of before, and no longer breaks the cluster rules: the cases that used to be the
+/// named failure `snow_clutter_breaks_nitsch_and_grid` (nitsch 0.947 -> 0.379 on `city`, seed
+/// 15402, 4.7 mm/h; grid 0.965 -> 0.0 on `highway`, seed 109, 5 mm/h, the largest calibrated rate)
+/// now lose at most a few thousandths of the ground recall.
 #[test]
-fn snow_clutter_breaks_nitsch_and_grid() {
+fn calibrated_snow_leaves_nitsch_and_grid_their_ground() {
     let (clear, snow) = recalls("city", 15_402, Weather::Snow { rate_mm_h: 4.7 }, "nitsch");
-    assert!(clear > 0.9 && snow < 0.6, "{clear} -> {snow}");
+    assert!(clear > 0.9 && clear - snow < 0.02, "{clear} -> {snow}");
     let (clear, snow) = recalls("highway", 109, Weather::Snow { rate_mm_h: 5.0 }, "grid");
-    assert!(clear > 0.9 && snow < 0.3, "{clear} -> {snow}");
+    assert!(clear > 0.9 && clear - snow < 0.02, "{clear} -> {snow}");
 }

@@ -1,24 +1,45 @@
 //! Rain drops and snowflakes in the beam: drawn per beam from their size distributions, each
-//! returning the share of the beam it covers.
+//! returning what its backscatter cross-section sends into the receiver.
 //!
-//! - **Sizes**: exponential, `N(D) = N_0 exp(-Lambda D)` per m^3 per mm. Rain: Marshall-Palmer,
-//!   `N_0 = 8000`, `Lambda = 4.1 R^-0.21` (R in mm/h), drops up to 6 mm. Snow: Gunn-Marshall in
-//!   melted diameters, `N_0 = 3800 R^-0.87`, `Lambda = 2.55 R^-0.48`, flakes of density 0.1 g/cm^3
-//!   (diameter `10^(1/3) = 2.15` times the melted one, as in Hahner et al., CVPR 2022), up to 20 mm.
+//! - **Sizes**: exponential, `N(D) = N_0 exp(-Lambda D)` per m^3 per mm. Rain: Marshall-Palmer
+//!   (1948), `N_0 = 8000`, `Lambda = 4.1 R^-0.21` (R in mm/h), drops up to 6 mm. Snow: Sekhon and
+//!   Srivastava (1970, J. Atmos. Sci. 27, 299: radar-measured snow spectra) in melted diameters,
+//!   `N_0 = 2500 R^-0.94`, `Lambda = 2.29 R^-0.45`, flakes of density 0.1 g/cm^3 (diameter
+//!   `10^(1/3) = 2.15` times the melted one, as in Hahner et al., CVPR 2022), up to 20 mm. (Gunn
+//!   and Marshall 1958, `N_0 = 3800 R^-0.87`, `Lambda = 2.55 R^-0.48`, has 1.5 times the flakes and
+//!   a tail that grows faster with the rate: it puts 3 mm/h above WADS's band.)
+//! - **Projected area** `A(D) = gamma D^sigma`: drops are spheres (`pi/4 D^2`); snowflakes are
+//!   aggregates whose projected area is Mitchell's (1996, J. Atmos. Sci. 53, 1710: aggregates of
+//!   side planes, bullets and columns, `A = 0.2285 D^1.88` in cgs, i.e. `0.301 D^1.88` mm^2 with D
+//!   in mm): 38 % of the disk at 1 mm, 32 % at 5 mm.
 //! - **Extinction** from the same distribution, geometric optics (extinction efficiency 2):
-//!   `alpha = (pi / 2) int D^2 N(D) dD = pi N_0 / Lambda^3` (with D in metres): 1.6e-3 /m in rain of
-//!   10 mm/h, 5e-3 /m in snow of 2 mm/h.
-//! - **A particle's return**: a Lambertian disk of reflectance `rho_p` (snow 0.9, as Hahner et al.;
-//!   rain 0.05: clear water returns little to the sensor) covering `min(1, (D / d(R))^2)` of the
-//!   beam, whose diameter grows as `d(R) = d_0 + theta R` (`d_0` = 1 cm exit aperture, `theta` the
-//!   sensor's divergence): power `rho_p min(1, (D / d)^2) (r_ref / R)^2 xi(R) exp(-2 alpha R)`.
+//!   `alpha = 2 int A(D) N(D) dD = 2 gamma N_0 Gamma(sigma + 1) / Lambda^(sigma + 1)`: 1.6e-3 /m
+//!   in rain of 10 mm/h, 1.3e-3 /m in snow of 2 mm/h.
+//! - **A particle's return**: backscatter cross-section per steradian `sigma_pi = 2 A / S`, `S`
+//!   the particle's lidar ratio (extinction over backscatter, sr). In the intensity model's units
+//!   (a Lambertian target of reflectance `rho` filling the beam returns `rho (r_ref / R)^2`), a
+//!   particle returns `rho_p min(1, A(D) / A_beam(R)) (r_ref / R)^2 xi(R) exp(-2 alpha R)` with the
+//!   equivalent reflectance `rho_p = pi sigma_pi / A = 2 pi / S`. Snow: ice crystals' lidar ratio
+//!   `S = 29 sr` (Chen, Chiang and Nee 2002, Appl. Opt. 41, 6470: cirrus, 29 +- 12 sr; large ice
+//!   particles scatter by geometric optics, so the figure holds at 905 nm): `rho_p = 0.217`. Rain:
+//!   `rho_p = 0.05` (as before; not fitted, see docs/weather.md).
+//! - **The beam**: diameter `d(R) = d_0 + theta R`, `d_0` = 11 mm, the exit spot of a spinning
+//!   unit's lens (Velodyne VLP-16 user manual: 9.5 x 12.7 mm at the exit, the same area as a
+//!   disk of 11 mm), `theta` the sensor's divergence.
+//! - **The receiver's near-range overlap** `xi(R)` ([`bistatic_overlap`]): transmitter and
+//!   receiver are side-by-side lenses of the same aperture `d_0` whose axes lie
+//!   [`AXIS_SEPARATION_M`] apart, the receiver's field of view [`RECEIVER_FOV_PER_DIVERGENCE`]
+//!   times the beam's divergence; `xi` is the share of the beam's spot inside the receiver's field
+//!   (two circles' intersection over the spot's area): none before 4.0 m, full from 34.7 m. A
+//!   bright hard target is seen from far nearer (its power is thousands of times the threshold);
+//!   a flake, near the threshold, is not. Fog keeps Hahner et al.'s overlap (0.9-1.0 m), with
+//!   which its constants were set.
 //! - **Per beam**: the particles that could beat the beam's floor (the threshold, or the target's
-//!   power when it is stronger) form a Poisson process along the beam, of rate
-//!   `A(R) int_{D_min(R)} N(D) dD` per metre (`A` the beam's cross-section). A table holds its
-//!   cumulative rate for floors on a factor-sqrt(2) ladder; a beam draws the ladder band of its
-//!   strongest particle directly and only the one to few particles in it
-//!   ([`ParticleTable::strongest`]), and the strongest one that beats the floor is the medium's
-//!   return.
+//!   power when it is stronger: the strongest return wins) form a Poisson process along the beam,
+//!   of rate `A_beam(R) int_{D_min(R)} N(D) dD` per metre. A table holds its cumulative rate for
+//!   floors on a factor-sqrt(2) ladder; a beam draws the ladder band of its strongest particle
+//!   directly and only the one to few particles in it ([`ParticleTable::strongest`]), and the
+//!   strongest one that beats the floor is the medium's return.
 
 use rand::RngExt;
 
@@ -35,16 +56,40 @@ pub struct Particles {
     pub lambda_per_mm: f64,
     /// Largest diameter, mm.
     pub d_max_mm: f64,
-    /// Reflectance of a particle.
+    /// Equivalent reflectance of a particle that fills the beam: `2 pi / S`, `S` its lidar ratio
+    /// (module docs).
     pub reflectance: f64,
+    /// Projected area `gamma D^sigma` (mm^2, D in mm): `gamma`.
+    pub area_coefficient_mm2: f64,
+    /// Projected area `gamma D^sigma`: `sigma`.
+    pub area_exponent: f64,
     /// The class of its returns.
     pub class: SemanticClass,
 }
 
 /// Flake diameter per melted diameter at a snow density of 0.1 g/cm^3: `10^(1/3)`.
 const FLAKE_PER_MELTED: f64 = 2.154_434_690_031_884;
-/// The beam's diameter at the exit aperture, m.
-pub const APERTURE_M: f64 = 0.01;
+/// The beam's diameter at the exit aperture, m: the VLP-16's exit spot, 9.5 x 12.7 mm (its user
+/// manual), as a disk of the same area.
+pub const APERTURE_M: f64 = 0.011;
+/// Distance between the transmitter's and the receiver's optical axes, m (side-by-side lenses of
+/// [`APERTURE_M`] with a 15 mm gap between them). With the receiver's field below, the overlap
+/// starts at 4.0 m and is full from 34.7 m. Not from a datasheet: this and the receiver's field
+/// are the two figures set by a measurement, WADS's labelled snowfall (no flakes nearer than 3 m,
+/// median 6.5-6.9 m, a few per cent of the returns; docs/weather.md).
+pub const AXIS_SEPARATION_M: f64 = 0.026;
+/// The receiver's field of view per beam divergence (full angles): 1.5, a field a little wider
+/// than the beam so that the beam stays in it at long range. Set with [`AXIS_SEPARATION_M`] by
+/// WADS's figures.
+pub const RECEIVER_FOV_PER_DIVERGENCE: f64 = 1.5;
+/// Lidar ratio (extinction over backscatter) of ice particles, sr: 29 sr (Chen, Chiang and Nee
+/// 2002, cirrus clouds).
+pub const ICE_LIDAR_RATIO_SR: f64 = 29.0;
+/// Mitchell (1996) projected area of aggregates, `A = 0.2285 D^1.88` (cm^2, D in cm), in mm^2 with
+/// D in mm: `100 * 0.2285 * 10^-1.88`.
+const AGGREGATE_AREA_COEFFICIENT_MM2: f64 = 0.301_22;
+/// Mitchell (1996): the exponent of the aggregates' projected area.
+const AGGREGATE_AREA_EXPONENT: f64 = 1.88;
 
 impl Particles {
     /// Rain of `rate_mm_h` (Marshall-Palmer).
@@ -55,19 +100,23 @@ impl Particles {
             lambda_per_mm: 4.1 * r.powf(-0.21),
             d_max_mm: 6.0,
             reflectance: 0.05,
+            area_coefficient_mm2: std::f64::consts::FRAC_PI_4,
+            area_exponent: 2.0,
             class: SemanticClass::RAIN,
         }
     }
 
-    /// Snow of `rate_mm_h` of water (Gunn-Marshall, flakes of density 0.1 g/cm^3).
+    /// Snow of `rate_mm_h` of water (Sekhon-Srivastava, flakes of density 0.1 g/cm^3).
     pub fn snow(rate_mm_h: f64) -> Self {
         let r = rate_mm_h.max(1e-6);
-        let (n0, lambda) = (3800.0 * r.powf(-0.87), 2.55 * r.powf(-0.48));
+        let (n0, lambda) = (2500.0 * r.powf(-0.94), 2.29 * r.powf(-0.45));
         Self {
             n0_per_m3_mm: if rate_mm_h > 0.0 { n0 / FLAKE_PER_MELTED } else { 0.0 },
             lambda_per_mm: lambda / FLAKE_PER_MELTED,
             d_max_mm: 20.0,
-            reflectance: 0.9,
+            reflectance: 2.0 * std::f64::consts::PI / ICE_LIDAR_RATIO_SR,
+            area_coefficient_mm2: AGGREGATE_AREA_COEFFICIENT_MM2,
+            area_exponent: AGGREGATE_AREA_EXPONENT,
             class: SemanticClass::SNOW,
         }
     }
@@ -81,11 +130,67 @@ impl Particles {
         self.n0_per_m3_mm / l * ((-l * d_mm.max(0.0)).exp() - (-l * self.d_max_mm).exp())
     }
 
-    /// Extinction coefficient, 1/m: `(pi / 2) int D^2 N(D) dD` (the untruncated tail is
-    /// negligible).
+    /// Extinction coefficient, 1/m: `2 int A(D) N(D) dD = 2 gamma N_0 Gamma(sigma + 1) /
+    /// Lambda^(sigma + 1)` (the untruncated tail is negligible).
     pub fn extinction_per_m(&self) -> f64 {
-        std::f64::consts::PI * self.n0_per_m3_mm / self.lambda_per_mm.powi(3) * 1e-6
+        let sigma = self.area_exponent;
+        2.0 * self.area_coefficient_mm2 * self.n0_per_m3_mm * gamma_fn(sigma + 1.0)
+            / self.lambda_per_mm.powf(sigma + 1.0)
+            * 1e-6
     }
+
+    /// Projected area of a particle of diameter `d_mm`, mm^2.
+    pub fn area_mm2(&self, d_mm: f64) -> f64 {
+        self.area_coefficient_mm2 * d_mm.powf(self.area_exponent)
+    }
+
+    /// The diameter (mm) whose projected area is `area_mm2`.
+    fn diameter_of_area_mm(&self, area_mm2: f64) -> f64 {
+        (area_mm2 / self.area_coefficient_mm2).powf(1.0 / self.area_exponent)
+    }
+}
+
+/// The gamma function for `x > 0` (Lanczos, g = 7, nine terms: 15 digits).
+fn gamma_fn(x: f64) -> f64 {
+    const G: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        return std::f64::consts::PI / ((std::f64::consts::PI * x).sin() * gamma_fn(1.0 - x));
+    }
+    let x = x - 1.0;
+    let t = x + 7.5;
+    let sum = G.iter().enumerate().skip(1).fold(G[0], |acc, (i, g)| acc + g / (x + i as f64));
+    (2.0 * std::f64::consts::PI).sqrt() * t.powf(x + 0.5) * (-t).exp() * sum
+}
+
+/// The share of a beam's spot at `range_m` that the receiver sees: the intersection of the spot
+/// (diameter `APERTURE_M + theta R`) and the receiver's field (`APERTURE_M + k theta R`, `k` =
+/// [`RECEIVER_FOV_PER_DIVERGENCE`]), their centres [`AXIS_SEPARATION_M`] apart, over the spot's
+/// area. 0 for a beam without divergence (its spot never meets the field).
+pub fn bistatic_overlap(range_m: f64, divergence_rad: f64) -> f64 {
+    let a = 0.5 * (APERTURE_M + divergence_rad * range_m);
+    let b = 0.5 * (APERTURE_M + RECEIVER_FOV_PER_DIVERGENCE * divergence_rad * range_m);
+    let s = AXIS_SEPARATION_M;
+    if s >= a + b {
+        return 0.0;
+    }
+    if s <= (b - a).abs() {
+        return (a.min(b) / a).powi(2);
+    }
+    let alpha = ((s * s + a * a - b * b) / (2.0 * s * a)).clamp(-1.0, 1.0).acos();
+    let beta = ((s * s + b * b - a * a) / (2.0 * s * b)).clamp(-1.0, 1.0).acos();
+    let kite = 0.5 * ((-s + a + b) * (s + a - b) * (s - a + b) * (s + a + b)).max(0.0).sqrt();
+    // (Clamped: at tangency the three terms cancel to a rounding error of either sign.)
+    ((a * a * alpha + b * b * beta - kite) / (std::f64::consts::PI * a * a)).clamp(0.0, 1.0)
 }
 
 /// Floors on the ladder, from the detection threshold up by factors of sqrt(2).
@@ -148,18 +253,31 @@ impl ParticleTable {
         APERTURE_M + self.divergence_rad * r
     }
 
-    /// Power of a whole-beam return at `r` (a particle covering the beam).
+    /// Power of a whole-beam return at `r` (a particle covering the beam the receiver sees).
     fn full_power(&self, r: f64) -> f64 {
-        self.particles.reflectance * (self.r_ref / r).powi(2) * super::fog::overlap(r) * (-2.0 * self.alpha * r).exp()
+        self.particles.reflectance
+            * (self.r_ref / r).powi(2)
+            * bistatic_overlap(r, self.divergence_rad)
+            * (-2.0 * self.alpha * r).exp()
+    }
+
+    /// The beam's cross-section at `r`, mm^2.
+    fn beam_area_mm2(&self, r: f64) -> f64 {
+        std::f64::consts::FRAC_PI_4 * (self.beam_m(r) * 1e3).powi(2)
+    }
+
+    /// The power of a particle of diameter `d_mm` at `r` whose whole-beam power there is `full`.
+    fn power(&self, d_mm: f64, r: f64, full: f64) -> f64 {
+        (self.particles.area_mm2(d_mm) / self.beam_area_mm2(r)).min(1.0) * full
     }
 
     /// The smallest diameter (mm) whose return at `r` reaches `floor`, or `None` when none does.
     fn d_min_mm(&self, r: f64, floor: f64) -> Option<f64> {
         let full = self.full_power(r);
-        if full < floor {
+        if full < floor || full <= 0.0 {
             return None;
         }
-        Some(self.beam_m(r) * (floor / full).sqrt() * 1e3)
+        Some(self.particles.diameter_of_area_mm(self.beam_area_mm2(r) * floor / full))
     }
 
     /// Particles per metre of beam at `r` that reach `floor`.
@@ -246,16 +364,17 @@ impl ParticleTable {
             }
             // Its size: the exponential between the two floors' smallest diameters there.
             let full = self.full_power(r);
-            if full < lower {
+            if full < lower || full <= 0.0 {
                 continue;
             }
-            let beam_mm = self.beam_m(r) * 1e3;
-            let d_lo = beam_mm * (lower / full).sqrt();
-            let d_hi = if full >= upper { beam_mm * (upper / full).sqrt() } else { f64::INFINITY };
+            let beam_mm2 = self.beam_area_mm2(r);
+            let d_lo = self.particles.diameter_of_area_mm(beam_mm2 * lower / full);
+            let d_hi =
+                if full >= upper { self.particles.diameter_of_area_mm(beam_mm2 * upper / full) } else { f64::INFINITY };
             let d_hi = d_hi.min(self.particles.d_max_mm);
             let span = 1.0 - (-l * (d_hi - d_lo).max(0.0)).exp();
             let d = d_lo - (1.0 - rng.random::<f64>() * span).ln() / l;
-            let p = (d / beam_mm).powi(2).min(1.0) * full;
+            let p = self.power(d, r, full);
             if p >= floor && best.is_none_or(|(_, bp)| p > bp) {
                 best = Some((r, p));
             }
@@ -295,10 +414,42 @@ mod tests {
         assert!((rain.extinction_per_m() - 1.56e-3).abs() < 0.02e-3, "{}", rain.extinction_per_m());
         // Its total number density N_0 / Lambda (truncation at 6 mm is negligible).
         assert!((rain.count_above(0.0) - 8000.0 / rain.lambda_per_mm).abs() < 1.0);
+        // Sekhon-Srivastava at 2 mm/h in flake diameters (N_0 = 604.8 /m^3/mm, Lambda = 0.7781 /mm)
+        // with Mitchell's area: alpha = 2 * 0.30122 * N_0 * Gamma(2.88) / Lambda^2.88 = 1.348e-3 /m.
         let snow = Particles::snow(2.0);
-        assert!((snow.extinction_per_m() - 4.95e-3).abs() < 0.05e-3, "{}", snow.extinction_per_m());
+        assert!((snow.extinction_per_m() - 1.3476e-3).abs() < 0.001e-3, "{}", snow.extinction_per_m());
+        // Aggregates cover 38 % of their disk at 1 mm.
+        assert!((snow.area_mm2(1.0) / std::f64::consts::FRAC_PI_4 - 0.3835).abs() < 1e-3);
         assert_eq!(Particles::snow(0.0).extinction_per_m(), 0.0);
         assert_eq!(Particles::rain(0.0).count_above(0.0), 0.0);
+    }
+
+    #[test]
+    fn gamma_function_matches_known_values() {
+        assert!((gamma_fn(3.0) - 2.0).abs() < 1e-12);
+        assert!((gamma_fn(0.5) - std::f64::consts::PI.sqrt()).abs() < 1e-12);
+        assert!((gamma_fn(2.88) - 1.88 * gamma_fn(1.88)).abs() < 1e-12);
+    }
+
+    /// The receiver sees none of the spot before the circles meet, `(s - d_0) / ((1 + k) theta /
+    /// 2)` = 4.0 m at 3 mrad, all of it once the field's radius exceeds the spot's by `s`,
+    /// `s / ((k - 1) theta / 2)` = 34.7 m, and more with range in between.
+    #[test]
+    fn the_overlap_follows_the_bistatic_geometry() {
+        let theta = 0.003;
+        let start = (AXIS_SEPARATION_M - APERTURE_M) / (0.5 * (1.0 + RECEIVER_FOV_PER_DIVERGENCE) * theta);
+        let full = AXIS_SEPARATION_M / (0.5 * (RECEIVER_FOV_PER_DIVERGENCE - 1.0) * theta);
+        assert!((start - 4.0).abs() < 1e-3 && (full - 34.667).abs() < 1e-3, "{start} {full}");
+        assert_eq!(bistatic_overlap(start - 0.01, theta), 0.0);
+        assert!(bistatic_overlap(start + 0.05, theta) > 0.0);
+        assert!(bistatic_overlap(full - 0.5, theta) < 1.0);
+        assert_eq!(bistatic_overlap(full + 0.01, theta), 1.0);
+        let xs: Vec<f64> = (0..300).map(|k| bistatic_overlap(k as f64 * 0.1, theta)).collect();
+        assert!(xs.windows(2).all(|w| w[0] <= w[1] + 1e-12), "not monotone");
+        // Half way the two circles' intersection is a fraction strictly between.
+        let mid = bistatic_overlap(15.0, theta);
+        assert!(mid > 0.3 && mid < 0.9, "{mid}");
+        assert_eq!(bistatic_overlap(50.0, 0.0), 0.0, "a beam without divergence never meets the field");
     }
 
     /// The mean number of particles a beam reports matches the table's expectation: the Poisson
