@@ -9,9 +9,9 @@
 
 use std::f32::consts::TAU;
 
-use super::matching::match_points;
+use super::matching::{match_points, row_of};
 use super::{
-    DUAL_FRACTION, RecoveredOrder, RecoveredSensor, Recovery, cell_of, columns_from_steps, median, named_table,
+    DUAL_FRACTION, RecoveredOrder, RecoveredSensor, Recovery, cell_in, columns_from_steps, median, named_table,
     unnamed_table, wrap_pi,
 };
 use crate::ordering::beam_table::BeamTable;
@@ -21,8 +21,9 @@ use crate::ordering::{InputPoint, PathChoice};
 pub const CLOSE_FRACTION: f64 = 0.9;
 
 /// Largest azimuth step between successive points of one firing or the next, degrees (the
-/// lasers' azimuth offsets: up to about 8 deg on an HDL-64E).
-pub const CLOSE_STEP_DEG: f32 = 10.0;
+/// lasers' azimuth offsets: -8.5 to +9.9 deg on an HDL-64E; a shuffled cloud's steps fall within
+/// it one time in six).
+pub const CLOSE_STEP_DEG: f32 = 30.0;
 
 /// Points sampled to fit the known tables.
 const FIT_SAMPLES: usize = 4096;
@@ -56,21 +57,26 @@ pub(crate) fn recover_firing<P: InputPoint>(
     let stride = n.div_ceil(FIT_SAMPLES).max(1);
     let sample: Vec<u32> = (0..n).step_by(stride).map(index).collect();
     let matched = match_points(points, &sample);
-    let (rows, rings, mean_error_deg) = match &matched {
-        Some(m) => (m.sensor.rows.clone(), m.sensor.rows.len(), Some(m.mean_error_deg)),
+    let (rows, along_m, rings, mean_error_deg) = match &matched {
+        Some(m) => (m.sensor.rows.clone(), Some(&m.sensor.along_m[..]), m.sensor.rows.len(), Some(m.mean_error_deg)),
         None => {
             let tan = unnamed_elevations(points, usable, n)?;
             let rows = unnamed_table(&tan, 2).rows().map_err(|e| e.to_string())?;
-            (rows, tan.len(), None)
+            (rows, None, tan.len(), None)
         }
     };
+    // Each point's row: its nearest beam seen from the beam's origin.
+    let mut point_rows = vec![0u16; points.len()];
+    for i in 0..n {
+        let k = index(i) as usize;
+        point_rows[k] = row_of(&rows, along_m, points[k].xyz()).0 as u16;
+    }
     // Columns: the azimuth step between successive points of one row.
     let window = n.min(WINDOW);
     let mut last = vec![f32::NAN; rows.len()];
     let mut steps = Vec::with_capacity(window);
     for i in 0..window {
-        let p = points[index(i) as usize].xyz();
-        let (row, _, _) = rows.nearest_row(p);
+        let row = usize::from(point_rows[index(i) as usize]);
         if last[row].is_finite() {
             steps.push(wrap_pi(az[i] - last[row]).abs());
         }
@@ -84,7 +90,7 @@ pub(crate) fn recover_firing<P: InputPoint>(
             (unnamed_table(&tan, cols_estimate), cols_estimate)
         }
     };
-    let second_echoes = second_echoes(points, usable, n, &table)?;
+    let second_echoes = second_echoes(points, usable, n, &table, &point_rows)?;
     Ok(Recovery {
         sensor: RecoveredSensor {
             model: matched.map(|m| m.sensor.model),
@@ -98,6 +104,7 @@ pub(crate) fn recover_firing<P: InputPoint>(
         table,
         choice: PathChoice::BeamTable,
         second_echoes,
+        point_rows: Some(point_rows),
     })
 }
 
@@ -108,13 +115,15 @@ fn second_echoes<P: InputPoint>(
     usable: Option<&[u32]>,
     n: usize,
     table: &BeamTable,
+    point_rows: &[u16],
 ) -> Result<Vec<u32>, String> {
     let rows = table.rows().map_err(|e| e.to_string())?;
     let mut held = vec![false; rows.len() * rows.cols];
     let mut second = Vec::new();
     for i in 0..n {
         let k = usable.map_or(i as u32, |u| u[i]);
-        let cell = cell_of(&rows, points[k as usize].xyz()) as usize;
+        let row = usize::from(point_rows[k as usize]);
+        let cell = cell_in(&rows, row, points[k as usize].xyz()) as usize;
         if held[cell] {
             second.push(k);
         }

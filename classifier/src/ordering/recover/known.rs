@@ -16,10 +16,10 @@ pub(crate) struct KnownSensor {
     pub model: &'static str,
     /// The default settings' table, rows sorted up (elevations and origin offsets).
     pub rows: TableRows,
-    /// Per grid row, its rank in the order the sensor fires and its driver writes a firing cycle
-    /// (the channel's index in the published table; for the older models, top beam first except
-    /// the VLP-16, whose lasers fire in their interleaved id order).
-    pub firing_rank_of_row: Vec<usize>,
+    /// Per row, how far its beam origin lies out along the beam's azimuth, metres (Ouster,
+    /// RoboSense: a few centimetres; the table's rows undo only the offsets across the beam and
+    /// up).
+    pub along_m: Vec<f32>,
     /// The settings of each rotation rate or lidar mode, with the columns they give.
     pub options: Vec<(usize, SensorSpec)>,
 }
@@ -37,22 +37,19 @@ pub(crate) fn known_sensors() -> &'static [KnownSensor] {
 
 fn known(model: &'static str) -> Option<KnownSensor> {
     let spec = SensorSpec::default_for(model).ok()?;
-    let rows = BeamTable::from_pattern(&spec.pattern()).ok()?.rows().ok()?;
-    let n = rows.len();
-    let firing_rank_of_row = match (&spec, spec.catalogued()) {
-        (_, Some((entry, _))) => {
-            let mut rank = vec![0; n];
-            for (channel, row) in entry.channel_of_row().into_iter().enumerate().map(|(r, c)| (c, r)) {
-                rank[row] = channel;
-            }
-            rank
-        }
-        // VLP-16 laser ids: -15, +1, -13, +3, ... deg: even ids the lower half, odd the upper.
-        (SensorSpec::Vlp16(_), None) => (0..n).map(|r| if r < n / 2 { 2 * r } else { 2 * (r - n / 2) + 1 }).collect(),
-        _ => (0..n).map(|r| n - 1 - r).collect(),
-    };
+    let pattern = spec.pattern();
+    let rows = BeamTable::from_pattern(&pattern).ok()?.rows().ok()?;
+    // The pattern's rows are sorted up, as the table's.
+    let along_m = (0..pattern.rows)
+        .map(|r| {
+            (0..pattern.cols).find_map(|c| pattern.at(r, c)).map_or(0.0, |f| {
+                let d = glam::Vec2::new(f.dir_in_sensor.x, f.dir_in_sensor.y).normalize_or_zero();
+                f.origin_in_sensor.x * d.x + f.origin_in_sensor.y * d.y
+            })
+        })
+        .collect();
     let options = column_options(&spec);
-    Some(KnownSensor { model, rows, firing_rank_of_row, options })
+    Some(KnownSensor { model, rows, along_m, options })
 }
 
 /// The settings of every rotation rate (and Ouster lidar mode) of `spec`'s model that validates,
@@ -186,9 +183,6 @@ mod tests {
             let pattern = spec.pattern();
             assert_eq!(k.rows.len(), pattern.rows, "{}", k.model);
             assert!(k.options.iter().any(|o| o.0 == pattern.cols), "{}: {} columns", k.model, pattern.cols);
-            let mut ranks = k.firing_rank_of_row.clone();
-            ranks.sort_unstable();
-            assert_eq!(ranks, (0..pattern.rows).collect::<Vec<_>>(), "{}", k.model);
         }
         let hdl32e = known.iter().find(|k| k.model == "hdl32e").unwrap();
         assert_eq!(hdl32e.columns_near(2160.0), Some(2170));

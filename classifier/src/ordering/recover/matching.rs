@@ -10,7 +10,7 @@
 //!   within [`MATCH_MAX_DEG`]. The closest table (mean error plus [`MISSING_ROW_DEG`] per skipped
 //!   row) names the sensor.
 //! - **From points** (firing order, where rings are not runs of the file): each sampled point's
-//!   nearest row of a known table with the origin offsets undone ([`TableRows::nearest_row`]); a
+//!   nearest row of a known table (or a neighbour) with the beam origin offsets undone; a
 //!   table fits where at least [`FIT_FRACTION`] of the points lie within a fifth of the local beam
 //!   gap of their row and at least three quarters of its rows hold points. The best fit names the
 //!   sensor, the table with fewer rows where two fit alike.
@@ -105,34 +105,60 @@ pub(crate) fn match_rings(medians: &[f32], dist_m: &[f32]) -> Option<Matched> {
 }
 
 /// How well `sensor`'s table fits the sampled points: the fraction within a fifth of their row's
-/// beam gap, the fraction of rows that hold points, and the mean residual in degrees.
-fn fit<P: InputPoint>(points: &[P], sample: &[u32], rows: &TableRows) -> (f64, f64, f32) {
-    let n = rows.len();
-    let tan = &rows.tan_elevation;
+/// beam gap (the nearest row or a neighbour, each seen from its beam origin: up, across and along
+/// the beam), the fraction of rows that hold points, and the mean residual in degrees.
+fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> (f64, f64, f32) {
+    let rows = &sensor.rows;
+    let (n, tan) = (rows.len(), &rows.tan_elevation);
+    let gap = |r: usize| row_gap(tan, r);
     let mut held = vec![false; n];
     let (mut within, mut sum_deg) = (0usize, 0f64);
     for &k in sample {
-        let p = points[k as usize].xyz();
-        let (row, f, outside) = rows.nearest_row(p);
-        let gap = match row {
-            0 => tan[1] - tan[0],
-            r if r == n - 1 => tan[r] - tan[r - 1],
-            r => (tan[r + 1] - tan[r]).min(tan[r] - tan[r - 1]),
-        };
-        let resid = (f - tan[row]).abs();
-        held[row] = true;
-        within += usize::from(!outside && resid < 0.2 * gap);
-        sum_deg += f64::from(tan_diff_deg(f, tan[row], tan[row]));
+        let (best_row, best, outside) = row_of(rows, Some(&sensor.along_m), points[k as usize].xyz());
+        held[best_row] = true;
+        within += usize::from(!outside && best < 0.2);
+        sum_deg += f64::from((best * gap(best_row) / (1.0 + tan[best_row] * tan[best_row])).to_degrees());
     }
     let m = sample.len().max(1) as f64;
     (within as f64 / m, held.iter().filter(|&&h| h).count() as f64 / n as f64, (sum_deg / m) as f32)
+}
+
+/// The smaller gap of row `r` to its neighbours, `tan(elevation)`.
+fn row_gap(tan: &[f32], r: usize) -> f32 {
+    let n = tan.len();
+    match r {
+        0 => tan[1] - tan[0],
+        r if r == n - 1 => tan[r] - tan[r - 1],
+        r => (tan[r + 1] - tan[r]).min(tan[r] - tan[r - 1]),
+    }
+}
+
+/// The row of `p` (sensor frame) in `rows`: of the nearest row ([`TableRows::nearest_row`]) and
+/// its neighbours, the one whose beam, seen from its origin (up, across and, with `along_m`, out
+/// along the beam), passes closest; with its residual as a fraction of the row's gap, and whether
+/// `p` lies beyond the table's edge rows.
+pub(crate) fn row_of(rows: &TableRows, along_m: Option<&[f32]>, p: glam::Vec3) -> (usize, f32, bool) {
+    let (n, tan) = (rows.len(), &rows.tan_elevation);
+    let (row, f, outside) = rows.nearest_row(p);
+    let mut best = ((f - tan[row]).abs() / row_gap(tan, row), row);
+    if let Some(along) = along_m {
+        let d = (p.x * p.x + p.y * p.y).sqrt();
+        for r in row.saturating_sub(1)..=(row + 1).min(n - 1) {
+            let t = (p.z - rows.vertical_m[r]) / (d - along[r]).max(1e-3);
+            let e = (t - tan[r]).abs() / row_gap(tan, r);
+            if e < best.0 {
+                best = (e, r);
+            }
+        }
+    }
+    (best.1, best.0, outside)
 }
 
 /// The known sensor whose table fits the points `sample` (indices into `points`) best, if any fits.
 pub(crate) fn match_points<P: InputPoint>(points: &[P], sample: &[u32]) -> Option<Matched> {
     let mut best: Option<(f64, usize, Matched)> = None;
     for sensor in known_sensors() {
-        let (within, held, mean) = fit(points, sample, &sensor.rows);
+        let (within, held, mean) = fit(points, sample, sensor);
         if within < FIT_FRACTION || held < 0.75 {
             continue;
         }

@@ -41,7 +41,8 @@ pub use matching::{FIT_FRACTION, MATCH_MAX_DEG, MATCH_MEAN_DEG};
 use super::beam_table::{BeamTable, TableRows, round_fast, wrap_into};
 use super::unfold::{ring_starts, sampled_median};
 use super::{
-    CloudBuffer, InputPoint, OrderingReport, PathChoice, PointAttributes, UnfoldParams, order_cloud_into, polar,
+    CloudBuffer, InputPoint, OrderingPath, OrderingReport, PathChoice, PointAttributes, UnfoldParams, order_cloud_into,
+    polar,
 };
 use crate::error::Result;
 
@@ -145,6 +146,8 @@ pub(crate) struct Recovery {
     pub sensor: RecoveredSensor,
     /// Indices (into the points) of second echoes, increasing.
     pub second_echoes: Vec<u32>,
+    /// Firing order: each point's row (0 lowest), given to ordering as its ring.
+    pub point_rows: Option<Vec<u16>>,
 }
 
 /// The provisional table of ring-major unfolding: [`MAX_RINGS`] rows 0.05 deg apart (the smallest
@@ -331,13 +334,18 @@ fn from_rings(starts: &[usize], az: &[f32], dist: &[f32], tan: &[f32], index: im
         table,
         choice: PathChoice::Auto,
         second_echoes,
+        point_rows: None,
     }
 }
 
 /// The plane-0 cell of `p` in the grid of `rows`: its nearest row and the column of its beam
 /// azimuth.
 pub(crate) fn cell_of(rows: &TableRows, p: glam::Vec3) -> u32 {
-    let (row, _, _) = rows.nearest_row(p);
+    cell_in(rows, rows.nearest_row(p).0, p)
+}
+
+/// The plane-0 cell of `p` in row `row` of the grid of `rows`: the column of its beam azimuth.
+pub(crate) fn cell_in(rows: &TableRows, row: usize, p: glam::Vec3) -> u32 {
     let steps = rows.column_steps(rows.beam_azimuth(p, row));
     let col = wrap_into(round_fast(steps), rows.cols as f32);
     let col = if col.is_finite() && col >= 0.0 { (col as usize).min(rows.cols - 1) } else { 0 };
@@ -356,8 +364,10 @@ pub(crate) fn order_recovered<P: InputPoint>(
 ) -> Result<()> {
     let rec = recover(points)?;
     let params = UnfoldParams::default();
+    let rings = rec.point_rows.as_deref();
     if rec.second_echoes.is_empty() {
-        order_cloud_into(points, attributes, &rec.table, vehicle_from_sensor, rec.choice, &params, cloud, report)?;
+        let attributes = PointAttributes { rings, ..*attributes };
+        order_cloud_into(points, &attributes, &rec.table, vehicle_from_sensor, rec.choice, &params, cloud, report)?;
     } else {
         // The first echoes are ordered; each second echo shares the cell of its beam.
         let mut second = vec![false; points.len()];
@@ -365,16 +375,16 @@ pub(crate) fn order_recovered<P: InputPoint>(
             second[k as usize] = true;
         }
         let keep: Vec<usize> = (0..points.len()).filter(|&k| !second[k]).collect();
-        let pick = |v: &[P]| keep.iter().map(|&k| v[k]).collect::<Vec<P>>();
-        let sub_points = pick(points);
-        let labels = attributes.labels.map(|v| keep.iter().map(|&k| v[k]).collect::<Vec<_>>());
-        let intensity = attributes.intensity.map(|v| keep.iter().map(|&k| v[k]).collect::<Vec<_>>());
-        let time_s = attributes.time_s.map(|v| keep.iter().map(|&k| v[k]).collect::<Vec<_>>());
+        let sub_points = pick(&keep, points);
+        let labels = attributes.labels.map(|v| pick(&keep, v));
+        let intensity = attributes.intensity.map(|v| pick(&keep, v));
+        let time_s = attributes.time_s.map(|v| pick(&keep, v));
+        let sub_rings = rings.map(|v| pick(&keep, v));
         let sub_attributes = PointAttributes {
             labels: labels.as_deref(),
             intensity: intensity.as_deref(),
             time_s: time_s.as_deref(),
-            rings: None,
+            rings: sub_rings.as_deref(),
         };
         order_cloud_into(
             &sub_points,
@@ -392,11 +402,25 @@ pub(crate) fn order_recovered<P: InputPoint>(
             cells[k] = report.cell_of_point[i];
         }
         for &k in &rec.second_echoes {
-            cells[k as usize] = Some(cell_of(&rows, points[k as usize].xyz()));
+            let p = points[k as usize].xyz();
+            let cell = match rings {
+                Some(r) => cell_in(&rows, usize::from(r[k as usize]), p),
+                None => cell_of(&rows, p),
+            };
+            cells[k as usize] = Some(cell);
         }
         report.cell_of_point = cells;
         report.shared += rec.second_echoes.len();
     }
+    if rings.is_some() {
+        // Rows from each point's nearest beam: the beam-table path, with the beams' origins undone.
+        report.path = OrderingPath::BeamTable;
+    }
     report.sensor = Some(rec.sensor);
     Ok(())
+}
+
+/// The entries `keep` of `v`.
+fn pick<T: Copy>(keep: &[usize], v: &[T]) -> Vec<T> {
+    keep.iter().map(|&k| v[k]).collect()
 }
