@@ -59,6 +59,10 @@ pub enum ClassifyError {
     /// Training failed in the learning library.
     #[error("training: {0}")]
     Training(String),
+    /// A flat cloud whose rings cannot be recovered without its sensor (no ring field, neither scan
+    /// order nor firing order).
+    #[error(transparent)]
+    NoOrder(#[from] crate::ordering::RecoveryError),
     /// A beam table or unordered cloud that ordering recovery cannot use.
     #[error("ordering recovery: {0}")]
     Ordering(String),

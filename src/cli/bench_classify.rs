@@ -27,7 +27,8 @@ pub struct Args {
     #[arg(long, default_value = "city")]
     scene: String,
     /// Rig name or TOML file (with `--input`: the beam table for `.bin` files; left at its default,
-    /// `.bin` files use the HDL-64E nominal table as `classify` does without `--rig`).
+    /// `.bin` files are ordered on the sensor recovered from them, as `classify` does without
+    /// `--rig`).
     #[arg(long, default_value = "os1-128-roof")]
     rig: String,
     /// Frames to scan.

@@ -15,8 +15,12 @@
 //! they are). For a KITTI `.bin` it is every point of
 //! the file in file order; the points are first put into ring x column order ([`classifier::ordering`]):
 //! by scan unfolding where the file is in scan order (as KITTI's and ours are), else from the beam
-//! table of `--rig` (a single-sensor rig, with its origin offsets; default: the HDL-64E nominal
-//! table with 2170 columns, as real KITTI frames hold up to about 2,160 points per laser). Every point gets a cell (a shared cell keeps its second point on a
+//! table of `--rig` (a single-sensor rig, with its origin offsets). Without `--rig` or
+//! `--calibration` the sensor's rings and columns are recovered from the file (ring-major or
+//! firing order, single or dual returns) and the sensor is named where its elevations match a
+//! known table (`matched: hdl32e` in the printed summary; a real KITTI frame matches the HDL-64E
+//! and keeps the nominal table with 2170 columns), else ordered as an unnamed sensor; a file in
+//! neither order is refused ([`classifier::ordering::recover`]). Every point gets a cell (a shared cell keeps its second point on a
 //! further plane); only points with NaN or infinite coordinates are skipped (0, counted in the
 //! output; a file with more than 1 % of them is refused). The path taken and the counts are printed.
 //! Where the input has labels (PCD label field, KITTI `.label` beside the `.bin`), also

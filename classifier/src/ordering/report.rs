@@ -3,6 +3,8 @@
 
 use serde::Serialize;
 
+use super::RecoveredSensor;
+
 /// How a cloud was put into rows and columns.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -60,6 +62,9 @@ pub struct OrderingReport {
     pub skipped: usize,
     /// No-return points (0, 0, 0) skipped: decision 0.
     pub no_returns: usize,
+    /// The sensor recovered from the data, where none was given (no rig, no calibration file):
+    /// named when its table matched a known one ([`super::recover`]).
+    pub sensor: Option<RecoveredSensor>,
 }
 
 impl OrderingReport {
@@ -87,6 +92,9 @@ impl OrderingReport {
         }
         if self.outside > 0 {
             s.push_str(&format!(", {} beyond the beam table (kept in the edge row)", self.outside));
+        }
+        if let Some(sensor) = &self.sensor {
+            s.push_str(&format!("; sensor {}", sensor.summary()));
         }
         if let Some(f) = &self.fallback {
             s.push_str(&format!(" (not unfolded: {f})"));

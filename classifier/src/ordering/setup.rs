@@ -1,6 +1,7 @@
 //! What orders files from other tools: the beam table and the mount that takes sensor-frame points
-//! to the vehicle frame, from a single-sensor rig, the sensor's own calibration file, or the
-//! built-in HDL-64E nominal table; and the ordering of one KITTI-layout frame with it
+//! to the vehicle frame, from a single-sensor rig or the sensor's own calibration file; without
+//! either, a flat cloud's rings and columns are recovered from its data and its sensor named where
+//! a known table matches ([`super::recover`]); and the ordering of one KITTI-layout frame with it
 //! ([`SensorSetup::order_kitti`]): a scan-ordered or shuffled `.bin`, or an **organized** one, as
 //! Ouster clouds converted to `.bin` are stored (every cell of the sensor's image, no-returns as
 //! `0, 0, 0`, row by row or column by column).
@@ -35,16 +36,22 @@ pub struct SensorSetup {
     pub vehicle_from_sensor: Affine3A,
     /// Lasers of a calibration file, checked against organized clouds' rows.
     pub calibrated_lasers: Option<usize>,
+    /// Whether the sensor was not given (no rig, no calibration file): a flat cloud without a ring
+    /// field is then ordered on the sensor recovered from its data ([`super::recover`]), `table`
+    /// (the HDL-64E nominal one) serving only organized frames and ring fields.
+    pub recover: bool,
 }
 
 impl Default for SensorSetup {
-    /// The HDL-64E nominal table with [`KITTI_COLUMNS`] columns, no mount (points stay in the
-    /// sensor frame).
+    /// No sensor given: flat clouds are ordered on the sensor recovered from their data; the
+    /// HDL-64E nominal table with [`KITTI_COLUMNS`] columns orders organized frames and ring
+    /// fields; no mount (points stay in the sensor frame).
     fn default() -> Self {
         Self {
             table: BeamTable::hdl64e(KITTI_COLUMNS),
             vehicle_from_sensor: Affine3A::IDENTITY,
             calibrated_lasers: None,
+            recover: true,
         }
     }
 }
@@ -77,6 +84,7 @@ impl SensorSetup {
                     table: BeamTable::from_pattern(&s.spec.pattern())?,
                     vehicle_from_sensor: s.mount.vehicle_from_sensor(),
                     calibrated_lasers: None,
+                    recover: false,
                 }
             }
             None => Self::default(),
@@ -87,12 +95,16 @@ impl SensorSetup {
             let cols = cal.columns.unwrap_or(if rig.is_some() { setup.table.cols } else { KITTI_COLUMNS });
             setup.calibrated_lasers = Some(cal.lasers.len());
             setup.table = cal.to_table(cols);
+            setup.recover = false;
         }
         Ok(setup)
     }
 
     /// Orders a flat cloud (KITTI `.bin`, unorganized PCD, PLY) into `cloud` and `report`: by scan
-    /// unfolding where the points are in scan order, else by the beam table.
+    /// unfolding where the points are in scan order, else by the beam table. Without a sensor
+    /// given ([`SensorSetup::recover`]) and without a ring field, on the sensor recovered from the
+    /// points (`report.sensor`), refused ([`super::RecoveryError`]) where no order can be
+    /// recovered.
     pub fn order_flat<P: InputPoint>(
         &self,
         points: &[P],
@@ -100,6 +112,9 @@ impl SensorSetup {
         cloud: &mut CloudBuffer,
         report: &mut OrderingReport,
     ) -> Result<()> {
+        if self.recover && attributes.rings.is_none() {
+            return super::recover::order_recovered(points, attributes, self.vehicle_from_sensor, cloud, report);
+        }
         order_cloud_into(
             points,
             attributes,
@@ -316,7 +331,8 @@ mod tests {
             (0..beams).map(|r| (-15.0 + 30.0 * r as f32 / (beams - 1) as f32).to_radians()).collect(),
             cols,
         );
-        let setup = SensorSetup { table, vehicle_from_sensor: Affine3A::IDENTITY, calibrated_lasers: None };
+        let setup =
+            SensorSetup { table, vehicle_from_sensor: Affine3A::IDENTITY, calibrated_lasers: None, recover: false };
         for column_major in [false, true] {
             let rec = image(beams, cols, column_major);
             let (mut cloud, mut report) = (CloudBuffer::default(), OrderingReport::default());

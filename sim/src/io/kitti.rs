@@ -23,6 +23,13 @@
 //! full-turn sensor, whose column 0 is at +pi) down to 0 and then from `cols - 1` down to
 //! `cols / 2 + 1`; cells without a return are skipped. Scan unfolding
 //! (`classifier::ordering`) recovers rows and columns from that order.
+//!
+//! # Firing order
+//! The ROS drivers of Hesai and RoboSense sensors (nebula) emit a cloud in **firing order**: the
+//! lasers of one firing cycle, in the order of the sensor's channel table, then the next cycle; in
+//! dual-return mode both echoes of a cycle before the next one. [`firing_order`] gives that order
+//! (from each cell's firing time), and [`encode_in_order`] writes a `.bin` in it: a ring-less file
+//! as a user converting such a cloud gets.
 
 use std::path::Path;
 
@@ -37,11 +44,24 @@ use crate::scene::SemanticClass;
 /// `sensor_from_vehicle` when given. Returns `(bin, label, points)`.
 pub fn encode(cloud: &OrderedCloud, sensor_from_vehicle: Option<&Affine3A>) -> Result<(Vec<u8>, Vec<u8>, usize)> {
     cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
-    let order = scan_order(cloud);
+    encode_in_order(cloud, &scan_order(cloud), sensor_from_vehicle)
+}
+
+/// As [`encode`], with the returns in `order` (cells of `cloud`, e.g. [`firing_order`]'s) rather
+/// than scan order. Refused for a cell beyond the cloud.
+pub fn encode_in_order(
+    cloud: &OrderedCloud,
+    order: &[usize],
+    sensor_from_vehicle: Option<&Affine3A>,
+) -> Result<(Vec<u8>, Vec<u8>, usize)> {
+    cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
+    if let Some(&bad) = order.iter().find(|&&i| i >= cloud.len()) {
+        return Err(SimError::invalid("order", bad, format!("cells 0 ..= {} of the cloud", cloud.len().max(1) - 1)));
+    }
     let n = order.len();
     let mut bin = Vec::with_capacity(n * 16);
     let mut label = Vec::with_capacity(n * 4);
-    for i in order {
+    for &i in order {
         let p = cloud.point_in_vehicle[i];
         let p = sensor_from_vehicle.map_or(p, |t| t.transform_point3(p));
         let mut rec = [0u8; 16];
@@ -75,6 +95,25 @@ pub fn scan_order(cloud: &OrderedCloud) -> Vec<usize> {
         }
     }
     order
+}
+
+/// The cells of `cloud` that hold a return in firing order (module docs, "Firing order"): by firing
+/// cycle (`floor(time_s / cycle_s)`, `cycle_s` the sensor's firing cycle), then echo plane, then
+/// `firing_rank_of_row[row]` (the row's channel index in the sensor's table). Rows beyond
+/// `firing_rank_of_row` go after the others, in row order.
+pub fn firing_order(cloud: &OrderedCloud, firing_rank_of_row: &[usize], cycle_s: f64) -> Vec<usize> {
+    let plane_cells = cloud.rows * cloud.cols;
+    let mut keyed: Vec<(i64, usize, usize, usize)> = (0..cloud.len())
+        .filter(|&i| cloud.has_return(i))
+        .map(|i| {
+            let (plane, row) = (i / plane_cells.max(1), (i % plane_cells.max(1)) / cloud.cols.max(1));
+            let cycle = if cycle_s > 0.0 { (cloud.time_s[i] / cycle_s).floor() as i64 } else { 0 };
+            let rank = firing_rank_of_row.get(row).copied().unwrap_or(firing_rank_of_row.len() + row);
+            (cycle, plane, rank, i)
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|k| k.3).collect()
 }
 
 /// The calibration text: `Tr:` followed by the 12 row-major entries of `vehicle_from_sensor`.

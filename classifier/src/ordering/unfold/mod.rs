@@ -89,7 +89,7 @@ const MEDIAN_SAMPLES: usize = 128;
 
 /// The median of at most [`MEDIAN_SAMPLES`] evenly spaced values of `v` (every value of a shorter
 /// slice), selected in `scratch`.
-fn sampled_median(v: &[f32], scratch: &mut Vec<f32>) -> f32 {
+pub(crate) fn sampled_median(v: &[f32], scratch: &mut Vec<f32>) -> f32 {
     let stride = v.len().div_ceil(MEDIAN_SAMPLES).max(1);
     scratch.clear();
     scratch.extend(v.iter().step_by(stride));

@@ -1,0 +1,201 @@
+//! Naming the sensor: the elevation table the data shows against every known table
+//! ([`super::known`]).
+//!
+//! - **From rings** (scan order): each ring's median `tan(elevation)` seen from the sensor origin
+//!   and its median horizontal distance `d`; a known row `j` (elevation `t_j`, beam origin `v_j`
+//!   above the sensor origin) is seen at `t_j + v_j / d` from there. The rings, sorted by
+//!   elevation, are aligned to the rows by a monotone alignment that may skip rows (a laser
+//!   without returns) and minimises the summed error; a table matches where its rows are at most a
+//!   quarter more than the rings, the mean error is within [`MATCH_MEAN_DEG`] and the largest
+//!   within [`MATCH_MAX_DEG`]. The closest table (mean error plus [`MISSING_ROW_DEG`] per skipped
+//!   row) names the sensor.
+//! - **From points** (firing order, where rings are not runs of the file): each sampled point's
+//!   nearest row of a known table (or a neighbour) with the beam origin offsets undone; a
+//!   table fits where at least [`FIT_FRACTION`] of the points lie within a fifth of the local beam
+//!   gap of their row and at least three quarters of its rows hold points. The best fit names the
+//!   sensor, the table with fewer rows where two fit alike.
+
+use super::known::{KnownSensor, known_sensors};
+use crate::ordering::InputPoint;
+use crate::ordering::beam_table::TableRows;
+
+/// Largest mean error of the rings' elevations against a matched table, degrees (real units
+/// differ from their nominal tables by a few tenths of a degree).
+pub const MATCH_MEAN_DEG: f32 = 0.3;
+
+/// Largest error of one ring against its matched row, degrees.
+pub const MATCH_MAX_DEG: f32 = 1.5;
+
+/// What a skipped row adds to a table's score, degrees.
+const MISSING_ROW_DEG: f32 = 0.01;
+
+/// Fraction of sampled points that must lie within a fifth of their row's beam gap for a table to
+/// fit a cloud in firing order.
+pub const FIT_FRACTION: f64 = 0.9;
+
+/// A known sensor matched to the data.
+#[derive(Clone, Copy)]
+pub(crate) struct Matched {
+    /// The sensor.
+    pub sensor: &'static KnownSensor,
+    /// Mean error of the data's rings against its rows, degrees (from points: the mean residual).
+    pub mean_error_deg: f32,
+}
+
+/// The difference of two `tan(elevation)` values near `t`, degrees.
+fn tan_diff_deg(a: f32, b: f32, t: f32) -> f32 {
+    ((a - b).abs() / (1.0 + t * t)).to_degrees()
+}
+
+/// The monotone alignment of `medians` (sorted up, with each ring's median distance `dist_m`) to
+/// `rows`: the summed and the largest error, degrees; `None` where there are more rings than rows.
+fn align(medians: &[f32], dist_m: &[f32], rows: &TableRows) -> Option<(f32, f32)> {
+    let (k, r) = (medians.len(), rows.len());
+    if k == 0 || k > r {
+        return None;
+    }
+    let err = |i: usize, j: usize| {
+        let seen = rows.tan_elevation[j] + rows.vertical_m[j] / dist_m[i].max(0.5);
+        tan_diff_deg(medians[i], seen, medians[i])
+    };
+    // cost[i * r + j]: rings 0..=i aligned, ring i to row j; `worst` the largest error on that path.
+    let inf = f32::INFINITY;
+    let mut cost = vec![inf; k * r];
+    let mut worst = vec![inf; k * r];
+    for j in 0..=(r - k) {
+        cost[j] = err(0, j);
+        worst[j] = cost[j];
+    }
+    for i in 1..k {
+        let mut run = (inf, inf);
+        for j in i..=(r - k + i) {
+            let prev = (cost[(i - 1) * r + j - 1], worst[(i - 1) * r + j - 1]);
+            if prev.0 < run.0 {
+                run = prev;
+            }
+            let e = err(i, j);
+            cost[i * r + j] = run.0 + e;
+            worst[i * r + j] = run.1.max(e);
+        }
+    }
+    (k - 1..r).map(|j| (cost[(k - 1) * r + j], worst[(k - 1) * r + j])).min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// The known sensor whose table the rings' `medians` (`tan(elevation)` seen from the origin,
+/// sorted up) at median distances `dist_m` match best, if any matches.
+pub(crate) fn match_rings(medians: &[f32], dist_m: &[f32]) -> Option<Matched> {
+    let k = medians.len();
+    let mut best: Option<(f32, Matched)> = None;
+    for sensor in known_sensors() {
+        let r = sensor.rows.len();
+        if k > r || 4 * (r - k) > r {
+            continue;
+        }
+        let Some((sum, worst)) = align(medians, dist_m, &sensor.rows) else { continue };
+        let mean = sum / k as f32;
+        if mean > MATCH_MEAN_DEG || worst > MATCH_MAX_DEG {
+            continue;
+        }
+        let score = mean + MISSING_ROW_DEG * (r - k) as f32;
+        if best.as_ref().is_none_or(|b| score < b.0) {
+            best = Some((score, Matched { sensor, mean_error_deg: mean }));
+        }
+    }
+    best.map(|b| b.1)
+}
+
+/// How well `sensor`'s table fits the sampled points: the fraction within a fifth of their row's
+/// beam gap (the nearest row or a neighbour, each seen from its beam origin: up, across and along
+/// the beam), the fraction of rows that hold points, and the mean residual in degrees.
+fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> (f64, f64, f32) {
+    let rows = &sensor.rows;
+    let (n, tan) = (rows.len(), &rows.tan_elevation);
+    let gap = |r: usize| row_gap(tan, r);
+    let mut held = vec![false; n];
+    let (mut within, mut sum_deg) = (0usize, 0f64);
+    for &k in sample {
+        let (best_row, best, outside) = row_of(rows, Some(&sensor.along_m), points[k as usize].xyz());
+        held[best_row] = true;
+        within += usize::from(!outside && best < 0.2);
+        sum_deg += f64::from((best * gap(best_row) / (1.0 + tan[best_row] * tan[best_row])).to_degrees());
+    }
+    let m = sample.len().max(1) as f64;
+    (within as f64 / m, held.iter().filter(|&&h| h).count() as f64 / n as f64, (sum_deg / m) as f32)
+}
+
+/// The smaller gap of row `r` to its neighbours, `tan(elevation)`.
+fn row_gap(tan: &[f32], r: usize) -> f32 {
+    let n = tan.len();
+    match r {
+        0 => tan[1] - tan[0],
+        r if r == n - 1 => tan[r] - tan[r - 1],
+        r => (tan[r + 1] - tan[r]).min(tan[r] - tan[r - 1]),
+    }
+}
+
+/// The row of `p` (sensor frame) in `rows`: of the nearest row ([`TableRows::nearest_row`]) and
+/// its neighbours, the one whose beam, seen from its origin (up, across and, with `along_m`, out
+/// along the beam), passes closest; with its residual as a fraction of the row's gap, and whether
+/// `p` lies beyond the table's edge rows.
+pub(crate) fn row_of(rows: &TableRows, along_m: Option<&[f32]>, p: glam::Vec3) -> (usize, f32, bool) {
+    let (n, tan) = (rows.len(), &rows.tan_elevation);
+    let (row, f, outside) = rows.nearest_row(p);
+    let mut best = ((f - tan[row]).abs() / row_gap(tan, row), row);
+    if let Some(along) = along_m {
+        let d = (p.x * p.x + p.y * p.y).sqrt();
+        for r in row.saturating_sub(1)..=(row + 1).min(n - 1) {
+            let t = (p.z - rows.vertical_m[r]) / (d - along[r]).max(1e-3);
+            let e = (t - tan[r]).abs() / row_gap(tan, r);
+            if e < best.0 {
+                best = (e, r);
+            }
+        }
+    }
+    (best.1, best.0, outside)
+}
+
+/// The known sensor whose table fits the points `sample` (indices into `points`) best, if any fits.
+pub(crate) fn match_points<P: InputPoint>(points: &[P], sample: &[u32]) -> Option<Matched> {
+    let mut best: Option<(f64, usize, Matched)> = None;
+    for sensor in known_sensors() {
+        let (within, held, mean) = fit(points, sample, sensor);
+        if within < FIT_FRACTION || held < 0.75 {
+            continue;
+        }
+        let rows = sensor.rows.len();
+        let better = best.as_ref().is_none_or(|b| within > b.0 + 0.01 || (within > b.0 - 0.01 && rows < b.1));
+        if better {
+            best = Some((within, rows, Matched { sensor, mean_error_deg: mean }));
+        }
+    }
+    best.map(|b| b.2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each known table's own elevations (seen from the origin at 20 m) match that table, also
+    /// with its two top lasers missing; the same elevations 2 degrees higher match none.
+    #[test]
+    fn each_known_table_matches_itself() {
+        for sensor in known_sensors() {
+            let rows = &sensor.rows;
+            let dist = vec![20.0f32; rows.len()];
+            let medians: Vec<f32> =
+                (0..rows.len()).map(|j| rows.tan_elevation[j] + rows.vertical_m[j] / 20.0).collect();
+            let m = match_rings(&medians, &dist).unwrap_or_else(|| panic!("{} unmatched", sensor.model));
+            assert_eq!(m.sensor.model, sensor.model);
+            assert!(m.mean_error_deg < 0.01, "{}: {}", sensor.model, m.mean_error_deg);
+            // Two lasers without returns (the top ones): still this sensor.
+            let short = rows.len() - 2;
+            let m = match_rings(&medians[..short], &dist[..short]).unwrap();
+            assert_eq!(m.sensor.model, sensor.model);
+            // Every elevation 2 degrees up: nothing matches.
+            let shifted: Vec<f32> = medians.iter().map(|t| (t.atan() + 2f32.to_radians()).tan()).collect();
+            if let Some(m) = match_rings(&shifted, &dist) {
+                panic!("{} shifted matched {}", sensor.model, m.sensor.model);
+            }
+        }
+    }
+}

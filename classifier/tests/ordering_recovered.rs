@@ -1,0 +1,102 @@
+//! Rings recovered without a sensor given, on hand-made clouds of a sensor no known table matches
+//! (20 beams, 1.58 deg apart): ring-major and firing order, single and dual returns, give every
+//! point its true cell and name no sensor; a shuffled cloud is refused with a typed error.
+
+use classifier::ClassifyError;
+use classifier::ordering::{
+    CloudBuffer, OrderingPath, OrderingReport, PointAttributes, RecoveredOrder, RecoveryError, SensorSetup,
+};
+use glam::Vec3;
+
+const BEAMS: usize = 20;
+const COLS: usize = 1000;
+
+/// The point of beam `row` (0 lowest, -25 .. +5 deg) in column `col` (column 0 just right of +pi,
+/// azimuth decreasing), `further` metres beyond the surface it hits (a floor 1.8 m below, walls
+/// 30 m away).
+fn point(row: usize, col: usize, further: f32) -> Vec3 {
+    let el = (-25.0 + 30.0 * row as f32 / (BEAMS - 1) as f32).to_radians();
+    let step = std::f32::consts::TAU / COLS as f32;
+    let az = std::f32::consts::PI - 0.5 * step - step * col as f32;
+    let r = if el < -0.03 { 1.8 / (-el).sin() } else { 30.0 / el.cos() };
+    Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin()) * (r + further)
+}
+
+/// Every cell in ring-major order (top laser first, each a counter-clockwise turn from the front).
+fn ring_major() -> Vec<(usize, usize)> {
+    let mut cells = Vec::new();
+    for row in (0..BEAMS).rev() {
+        for k in 0..COLS {
+            cells.push((row, (COLS / 2 + COLS - k) % COLS));
+        }
+    }
+    cells
+}
+
+/// Every cell in firing order: column by column (clockwise in time), channels top first.
+fn firing() -> Vec<(usize, usize)> {
+    (0..COLS).flat_map(|col| (0..BEAMS).rev().map(move |row| (row, col))).collect()
+}
+
+fn order(points: &[Vec3]) -> Result<(sim::OrderedCloud, OrderingReport), ClassifyError> {
+    let (mut cloud, mut report) = (CloudBuffer::default(), OrderingReport::default());
+    SensorSetup::default().order_flat(points, &PointAttributes::default(), &mut cloud, &mut report)?;
+    Ok((cloud.into_cloud(), report))
+}
+
+#[test]
+fn an_unnamed_sensor_is_recovered_in_ring_major_and_firing_order() {
+    for (kind, cells) in [(RecoveredOrder::RingMajor, ring_major()), (RecoveredOrder::Firing, firing())] {
+        let points: Vec<Vec3> = cells.iter().map(|&(r, c)| point(r, c, 0.0)).collect();
+        let (cloud, report) = order(&points).unwrap();
+        let sensor = report.sensor.clone().expect("recovered");
+        assert_eq!(sensor.model, None, "{}", report.summary());
+        assert_eq!((sensor.rings, sensor.rows, sensor.columns, sensor.order), (BEAMS, BEAMS, COLS, kind));
+        assert_eq!(sensor.echoes, 1);
+        assert!(report.summary().contains("unnamed sensor"), "{}", report.summary());
+        let path = if kind == RecoveredOrder::RingMajor { OrderingPath::Unfolded } else { OrderingPath::BeamTable };
+        assert_eq!(report.path, path);
+        assert_eq!((cloud.rows, cloud.cols), (BEAMS, COLS));
+        for (k, &(r, c)) in cells.iter().enumerate() {
+            assert_eq!(report.cell_of_point[k], Some((r * COLS + c) as u32), "{kind:?} point {k}");
+        }
+    }
+}
+
+#[test]
+fn dual_returns_share_their_first_echo_cell() {
+    // Ring-major: the first plane, then every third cell's second echo 2 m further, plane by plane.
+    let first = ring_major();
+    let seconds: Vec<(usize, usize)> = first.iter().copied().filter(|&(r, c)| (r + c) % 3 == 0).collect();
+    // Firing order: per column, the channels' first echoes, then their second echoes.
+    let mut fired = Vec::new();
+    for col in 0..COLS {
+        let column: Vec<(usize, usize, f32)> = (0..BEAMS).rev().map(|r| (r, col, 0.0)).collect();
+        fired.extend(column.iter().copied());
+        fired.extend(column.iter().filter(|&&(r, c, _)| (r + c) % 3 == 0).map(|&(r, c, _)| (r, c, 2.0)));
+    }
+    let ring_cells: Vec<(usize, usize, f32)> =
+        first.iter().map(|&(r, c)| (r, c, 0.0)).chain(seconds.iter().map(|&(r, c)| (r, c, 2.0))).collect();
+    for (kind, cells) in [(RecoveredOrder::RingMajor, ring_cells), (RecoveredOrder::Firing, fired)] {
+        let points: Vec<Vec3> = cells.iter().map(|&(r, c, f)| point(r, c, f)).collect();
+        let (cloud, report) = order(&points).unwrap();
+        let sensor = report.sensor.clone().expect("recovered");
+        assert_eq!((sensor.order, sensor.echoes, sensor.rows), (kind, 2, BEAMS), "{}", report.summary());
+        let second = cells.iter().filter(|c| c.2 > 0.0).count();
+        assert_eq!(report.shared, second, "{}", report.summary());
+        assert_eq!(cloud.returns(), BEAMS * COLS);
+        for (k, &(r, c, _)) in cells.iter().enumerate() {
+            assert_eq!(report.cell_of_point[k], Some((r * COLS + c) as u32), "{kind:?} point {k}");
+        }
+    }
+}
+
+#[test]
+fn a_shuffled_cloud_without_a_sensor_is_refused() {
+    let cells = ring_major();
+    let n = cells.len();
+    let points: Vec<Vec3> = (0..n).map(|k| cells[(k * 7919 + 13) % n]).map(|(r, c)| point(r, c, 0.0)).collect();
+    let e = order(&points).unwrap_err();
+    assert!(matches!(e, ClassifyError::NoOrder(RecoveryError::NoOrder { points: 20_000, .. })), "{e}");
+    assert!(e.to_string().contains("no ring order can be recovered from 20000 points"), "{e}");
+}
