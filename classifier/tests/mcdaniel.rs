@@ -7,7 +7,7 @@ use classifier::mcdaniel::{
     self, CandidateSet, Columns, FEATURE_NAMES, FeatureParams, McDaniel, McDanielModel, McDanielParams, ModelError,
     TrainParams, auc, roc_curve,
 };
-use classifier::{FrameInput, method_by_name, sensor_origin};
+use classifier::{FrameInput, ModelFileError, method_by_name, sensor_origin};
 use glam::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -313,15 +313,24 @@ fn model_files_round_trip_and_bad_ones_are_refused_with_the_file_named() {
     };
     // Missing file.
     let err = McDanielModel::load(&dir.path().join("none.json")).unwrap_err();
-    assert!(matches!(err, ModelError::Read { .. }) && err.to_string().contains("none.json"), "{err}");
+    assert!(
+        matches!(err, ModelError::File(ModelFileError::Read { .. })) && err.to_string().contains("none.json"),
+        "{err}"
+    );
     // Truncated.
     let err = load(&good[..good.len() / 2]);
-    assert!(matches!(err, ModelError::Json { .. }) && err.to_string().contains(&name), "{err}");
+    assert!(matches!(err, ModelError::File(ModelFileError::Json { .. })) && err.to_string().contains(&name), "{err}");
     // Another version, another format.
     let err = load(&good.replace("\"version\": 1", "\"version\": 2"));
-    assert!(matches!(err, ModelError::Version { .. }) && err.to_string().contains("version 2"), "{err}");
+    assert!(
+        matches!(err, ModelError::File(ModelFileError::Version { .. })) && err.to_string().contains("version 2"),
+        "{err}"
+    );
     let err = load(&good.replace(mcdaniel::MODEL_FORMAT, "libsvm"));
-    assert!(matches!(err, ModelError::Format { .. }), "{err}");
+    assert!(
+        matches!(err, ModelError::File(ModelFileError::Format { .. })) && err.to_string().contains("`mcdaniel` method"),
+        "{err}"
+    );
     // Wrong feature count.
     let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
     v["weights"].as_array_mut().unwrap().pop();

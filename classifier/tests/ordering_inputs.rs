@@ -3,8 +3,8 @@
 //! and counted, bad clouds refused, organized clouds stored top-first or without a ring field.
 
 use classifier::ordering::{
-    BeamTable, OrderingPath, PathChoice, PointAttributes, UnfoldParams, decisions_per_point, order_cloud,
-    order_organized,
+    BeamTable, OrderingPath, OrderingReport, PathChoice, PointAttributes, UnfoldParams, decisions_per_point,
+    order_cloud, order_organized,
 };
 use glam::{Affine3A, Vec3};
 
@@ -29,6 +29,17 @@ fn kitti_like(cols: usize) -> (BeamTable, Vec<Vec3>, Vec<(usize, usize)>) {
         }
     }
     (table, pts, truth)
+}
+
+/// [`order_cloud`] of points in the vehicle frame (the identity mount) with the default unfolding
+/// parameters.
+fn order_unmounted(
+    points: &[Vec3],
+    attributes: &PointAttributes<'_>,
+    table: &BeamTable,
+    choice: PathChoice,
+) -> Result<(sim::OrderedCloud, OrderingReport), classifier::ClassifyError> {
+    order_cloud(points, attributes, table, Affine3A::IDENTITY, choice, &UnfoldParams::default())
 }
 
 /// Every cell that one point of `pts` went to holds that point (through `vehicle_from_sensor`)
@@ -61,15 +72,7 @@ fn scan_order_unfolds_into_true_cells_despite_jitter_at_the_back() {
     // Jitter: a point at the back steps just across +-pi and back (an extra wrap inside a turn).
     let back = pts.iter().position(|p| (p.y.atan2(p.x) + std::f32::consts::PI).abs() < 0.012).unwrap();
     pts[back].y = -pts[back].y;
-    let (cloud, report) = order_cloud(
-        &pts,
-        &PointAttributes::default(),
-        &table,
-        Affine3A::IDENTITY,
-        PathChoice::Auto,
-        &UnfoldParams::default(),
-    )
-    .unwrap();
+    let (cloud, report) = order_unmounted(&pts, &PointAttributes::default(), &table, PathChoice::Auto).unwrap();
     assert_eq!(report.path, OrderingPath::Unfolded, "{}", report.summary());
     assert_eq!(report.rings_found, 16);
     assert_eq!(report.kept(), pts.len());
@@ -93,15 +96,7 @@ fn shuffled_points_fall_back_to_the_beam_table_and_bad_points_are_counted() {
     shuffled[5] = Vec3::new(f32::NAN, 0.0, 0.0);
     shuffled[77] = Vec3::new(0.0, f32::INFINITY, 0.0);
     shuffled[99] = Vec3::ZERO;
-    let (cloud, report) = order_cloud(
-        &shuffled,
-        &PointAttributes::default(),
-        &table,
-        Affine3A::IDENTITY,
-        PathChoice::Auto,
-        &UnfoldParams::default(),
-    )
-    .unwrap();
+    let (cloud, report) = order_unmounted(&shuffled, &PointAttributes::default(), &table, PathChoice::Auto).unwrap();
     assert_eq!(report.path, OrderingPath::BeamTable);
     assert!(report.fallback.is_some(), "{}", report.summary());
     assert_eq!((report.skipped, report.no_returns), (2, 1));
@@ -124,8 +119,7 @@ fn shuffled_points_fall_back_to_the_beam_table_and_bad_points_are_counted() {
 fn bad_clouds_are_refused() {
     let (table, mut pts, _) = kitti_like(90);
     let attrs = PointAttributes::default();
-    let order =
-        |p: &[Vec3]| order_cloud(p, &attrs, &table, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default());
+    let order = |p: &[Vec3]| order_unmounted(p, &attrs, &table, PathChoice::Auto);
     // More than 1 % NaN.
     let n = pts.len();
     for p in pts.iter_mut().take(n / 50) {
@@ -135,16 +129,13 @@ fn bad_clouds_are_refused() {
     assert!(e.contains("NaN or infinite"), "{e}");
     // One ring in the table.
     let one = BeamTable::spinning(vec![0.0], 90);
-    assert!(
-        order_cloud(&pts[n / 2..], &attrs, &one, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default())
-            .is_err()
-    );
+    assert!(order_unmounted(&pts[n / 2..], &attrs, &one, PathChoice::Auto).is_err());
     // Unfolding alone on shuffled points: refused, saying why.
     let mut shuffled = pts[n / 2..].to_vec();
     shuffled.reverse();
     shuffled.swap(3, 400);
     shuffled.swap(10, 700);
-    let e = order_cloud(&shuffled, &attrs, &table, Affine3A::IDENTITY, PathChoice::Unfold, &UnfoldParams::default());
+    let e = order_unmounted(&shuffled, &attrs, &table, PathChoice::Unfold);
     assert!(e.is_err() || e.unwrap().1.rings_found <= 16);
 }
 
@@ -225,9 +216,7 @@ fn ring_fields_give_rows_top_first_or_bottom_first_and_out_of_range_rings_are_re
         let rings: Vec<u16> =
             order.iter().map(|&k| if top_first { 15 - truth[k].0 as u16 } else { truth[k].0 as u16 }).collect();
         let attrs = PointAttributes { rings: Some(&rings), ..PointAttributes::default() };
-        let (_, report) =
-            order_cloud(&shuffled, &attrs, &table, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default())
-                .unwrap();
+        let (_, report) = order_unmounted(&shuffled, &attrs, &table, PathChoice::Auto).unwrap();
         assert_eq!(report.path, OrderingPath::RingField);
         assert_eq!(report.rings_found, 16);
         for (k, &o) in order.iter().enumerate() {
@@ -237,9 +226,7 @@ fn ring_fields_give_rows_top_first_or_bottom_first_and_out_of_range_rings_are_re
     let mut rings = vec![0u16; n];
     rings[17] = 16;
     let attrs = PointAttributes { rings: Some(&rings), ..PointAttributes::default() };
-    let e = order_cloud(&shuffled, &attrs, &table, Affine3A::IDENTITY, PathChoice::Auto, &UnfoldParams::default())
-        .unwrap_err()
-        .to_string();
+    let e = order_unmounted(&shuffled, &attrs, &table, PathChoice::Auto).unwrap_err().to_string();
     assert!(e.contains("ring 16, out of range"), "{e}");
 }
 

@@ -412,6 +412,13 @@ impl Scenario {
         for f in &mut frames {
             self.spec.vary(&mut f.cloud, f.index)?;
         }
-        Ok(Scan::new(frames, scene.family, scene.name, setup.rig, scene.geometry, self.spec.seed))
+        Ok(Scan {
+            frames,
+            family: scene.family,
+            scene_name: scene.name,
+            rig: setup.rig,
+            geometry: scene.geometry,
+            seed: self.spec.seed,
+        })
     }
 }

@@ -26,26 +26,15 @@ pub type Decisions = Vec<Vec<bool>>;
 /// ```
 #[derive(Clone, Debug)]
 pub struct Scan {
-    frames: Vec<Frame>,
-    family: String,
-    scene_name: String,
-    rig: sim::Rig,
-    geometry: Geometry,
-    seed: u64,
+    pub(crate) frames: Vec<Frame>,
+    pub(crate) family: String,
+    pub(crate) scene_name: String,
+    pub(crate) rig: sim::Rig,
+    pub(crate) geometry: Geometry,
+    pub(crate) seed: u64,
 }
 
 impl Scan {
-    pub(crate) fn new(
-        frames: Vec<Frame>,
-        family: String,
-        scene_name: String,
-        rig: sim::Rig,
-        geometry: Geometry,
-        seed: u64,
-    ) -> Self {
-        Self { frames, family, scene_name, rig, geometry, seed }
-    }
-
     /// Frames from elsewhere (files read back, a recording) as a scan of no known family, named
     /// `scene_name`: the regions that need a family's geometry (`RampSurface`, ...) are refused,
     /// the others work, with the bare ground at z = 0.
@@ -59,7 +48,14 @@ impl Scan {
     /// # Ok::<(), groundtruth_scenario::ScenarioError>(())
     /// ```
     pub fn from_frames(frames: Vec<Frame>, scene_name: &str, rig: sim::Rig) -> Self {
-        Self::new(frames, "unknown".into(), scene_name.into(), rig, Geometry::Other, 0)
+        Self {
+            frames,
+            family: "unknown".into(),
+            scene_name: scene_name.into(),
+            rig,
+            geometry: Geometry::Other,
+            seed: 0,
+        }
     }
 
     /// The scanned frames: labelled ordered clouds (points in the vehicle frame, labels, instances,

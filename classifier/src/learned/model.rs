@@ -23,11 +23,14 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::features::{FEATURE_COUNT, FEATURE_NAMES};
+use crate::model_file::{self, ModelFileError, ModelKind};
 
 /// The `format` of a model file.
 pub const MODEL_FORMAT: &str = "groundtruth-learned-oblivious-trees";
 /// The model file version this build reads and writes.
 pub const MODEL_VERSION: u32 = 1;
+/// The learned method's model files.
+const KIND: ModelKind = ModelKind { format: MODEL_FORMAT, version: MODEL_VERSION, method: "learned" };
 /// The deepest tree a model may hold.
 pub const MAX_DEPTH: usize = 10;
 /// The most trees a model may hold.
@@ -36,46 +39,9 @@ pub const MAX_TREES: usize = 100_000;
 /// Why a model file was refused; `path` names the file (`<built-in>` for the bundled model).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum LearnedModelError {
-    /// The file could not be read (missing, permissions).
-    #[error("model file {path}: cannot read: {message}")]
-    Read {
-        /// The file.
-        path: String,
-        /// The operating system's message.
-        message: String,
-    },
-    /// The file could not be written.
-    #[error("model file {path}: cannot write: {message}")]
-    Write {
-        /// The file.
-        path: String,
-        /// The message.
-        message: String,
-    },
-    /// Not valid JSON (e.g. truncated), or a field of the wrong type, missing or unknown.
-    #[error("model file {path}: invalid model JSON: {message}")]
-    Json {
-        /// The file.
-        path: String,
-        /// The parser's message (line and column).
-        message: String,
-    },
-    /// Another `format` (e.g. a McDaniel model given to the learned method).
-    #[error("model file {path}: format `{found}`, expected `{MODEL_FORMAT}` (a model of the `learned` method)")]
-    Format {
-        /// The file.
-        path: String,
-        /// The format found.
-        found: String,
-    },
-    /// Another `version`.
-    #[error("model file {path}: version {found}, this build reads version {MODEL_VERSION}")]
-    Version {
-        /// The file.
-        path: String,
-        /// The version found.
-        found: String,
-    },
+    /// The file could not be read, parsed or written, or holds another format or version.
+    #[error(transparent)]
+    File(#[from] ModelFileError),
     /// Another feature list.
     #[error("model file {path}: features {found:?}, this build computes {expected:?}")]
     Features {
@@ -186,19 +152,7 @@ impl LearnedModel {
 
     /// Parses and checks a model; `path` names it in errors.
     pub fn from_json_str(text: &str, path: &str) -> Result<Self, LearnedModelError> {
-        let v: serde_json::Value = serde_json::from_str(text)
-            .map_err(|e| LearnedModelError::Json { path: path.to_string(), message: e.to_string() })?;
-        // Format and version first, so that another method's model is named as such.
-        let format = v.get("format").and_then(|f| f.as_str()).unwrap_or("(none)");
-        if format != MODEL_FORMAT {
-            return Err(LearnedModelError::Format { path: path.to_string(), found: format.to_string() });
-        }
-        let version = v.get("version").map_or("(none)".to_string(), |x| x.to_string());
-        if version != MODEL_VERSION.to_string() {
-            return Err(LearnedModelError::Version { path: path.to_string(), found: version });
-        }
-        let model: LearnedModel = serde_json::from_value(v)
-            .map_err(|e| LearnedModelError::Json { path: path.to_string(), message: e.to_string() })?;
+        let model: LearnedModel = model_file::typed(model_file::parse(text, path, &KIND)?, path)?;
         model.check(path)?;
         Ok(model)
     }
@@ -248,9 +202,7 @@ impl LearnedModel {
 
     /// Reads a model file.
     pub fn load(path: &Path) -> Result<Self, LearnedModelError> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| LearnedModelError::Read { path: name.clone(), message: e.to_string() })?;
+        let (name, text) = model_file::read(path)?;
         Self::from_json_str(&text, &name)
     }
 
@@ -261,8 +213,7 @@ impl LearnedModel {
 
     /// Writes the model atomically (a temporary file, then a rename).
     pub fn save(&self, path: &Path) -> Result<(), LearnedModelError> {
-        sim::io::atomic::write_bytes_atomic(path, self.to_json_string().as_bytes())
-            .map_err(|e| LearnedModelError::Write { path: path.display().to_string(), message: e.to_string() })
+        Ok(model_file::write(path, &self.to_json_string())?)
     }
 }
 

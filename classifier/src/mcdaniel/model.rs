@@ -20,55 +20,21 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::{FEATURE_COUNT, FEATURE_NAMES, FeatureParams};
+use crate::model_file::{self, ModelFileError, ModelKind};
 
 /// The `format` of a model file.
 pub const MODEL_FORMAT: &str = "groundtruth-mcdaniel-linear-svm";
 /// The model file version this build reads and writes.
 pub const MODEL_VERSION: u32 = 1;
+/// The McDaniel method's model files.
+const KIND: ModelKind = ModelKind { format: MODEL_FORMAT, version: MODEL_VERSION, method: "mcdaniel" };
 
 /// Why a model file was refused; `path` names the file (`<built-in>` for the bundled model).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ModelError {
-    /// The file could not be read (missing, permissions).
-    #[error("model file {path}: cannot read: {message}")]
-    Read {
-        /// The file.
-        path: String,
-        /// The operating system's message.
-        message: String,
-    },
-    /// The file could not be written.
-    #[error("model file {path}: cannot write: {message}")]
-    Write {
-        /// The file.
-        path: String,
-        /// The message.
-        message: String,
-    },
-    /// Not valid JSON (e.g. truncated), or a field of the wrong type, missing or unknown.
-    #[error("model file {path}: invalid model JSON: {message}")]
-    Json {
-        /// The file.
-        path: String,
-        /// The parser's message (line and column).
-        message: String,
-    },
-    /// Another `format`.
-    #[error("model file {path}: format `{found}`, expected `{MODEL_FORMAT}`")]
-    Format {
-        /// The file.
-        path: String,
-        /// The format found.
-        found: String,
-    },
-    /// Another `version`.
-    #[error("model file {path}: version {found}, this build reads version {MODEL_VERSION}")]
-    Version {
-        /// The file.
-        path: String,
-        /// The version found.
-        found: String,
-    },
+    /// The file could not be read, parsed or written, or holds another format or version.
+    #[error(transparent)]
+    File(#[from] ModelFileError),
     /// An array with the wrong number of entries, or the wrong feature names.
     #[error("model file {path}: `{field}` has {found} entries, expected {FEATURE_COUNT} ({names})", names = FEATURE_NAMES.join(", "))]
     FeatureCount {
@@ -153,24 +119,7 @@ impl McDanielModel {
     /// Parses and checks a model from JSON text; `path` names the source in errors.
     pub fn from_json_str(text: &str, path: &str) -> Result<Self, ModelError> {
         let p = || path.to_string();
-        let value: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| ModelError::Json { path: p(), message: e.to_string() })?;
-        let obj = value
-            .as_object()
-            .ok_or_else(|| ModelError::Json { path: p(), message: "the top level is not a JSON object".into() })?;
-        match obj.get("format") {
-            Some(serde_json::Value::String(f)) if f == MODEL_FORMAT => {}
-            Some(other) => {
-                let found = other.as_str().map_or_else(|| other.to_string(), str::to_string);
-                return Err(ModelError::Format { path: p(), found });
-            }
-            None => return Err(ModelError::Json { path: p(), message: "missing field `format`".into() }),
-        }
-        match obj.get("version") {
-            Some(v) if v.as_u64() == Some(u64::from(MODEL_VERSION)) => {}
-            Some(v) => return Err(ModelError::Version { path: p(), found: v.to_string() }),
-            None => return Err(ModelError::Json { path: p(), message: "missing field `version`".into() }),
-        }
+        let obj = model_file::parse(text, path, &KIND)?;
         // Non-finite numbers are written as `null`: name them before the typed parse.
         for field in ["mean", "std", "weights"] {
             if let Some(serde_json::Value::Array(a)) = obj.get(field)
@@ -184,8 +133,7 @@ impl McDanielModel {
                 return Err(ModelError::NonFinite { path: p(), field: field.into() });
             }
         }
-        let model: McDanielModel =
-            serde_json::from_value(value).map_err(|e| ModelError::Json { path: p(), message: e.to_string() })?;
+        let model: McDanielModel = model_file::typed(obj, path)?;
         model.check(path)?;
         Ok(model)
     }
@@ -248,9 +196,7 @@ impl McDanielModel {
 
     /// Loads and checks a model file.
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ModelError::Read { path: name.clone(), message: e.to_string() })?;
+        let (name, text) = model_file::read(path)?;
         Self::from_json_str(&text, &name)
     }
 
@@ -265,7 +211,6 @@ impl McDanielModel {
     pub fn save(&self, path: &Path) -> Result<(), ModelError> {
         let name = path.display().to_string();
         self.check(&name)?;
-        sim::io::atomic::write_bytes_atomic(path, self.to_json_string().as_bytes())
-            .map_err(|e| ModelError::Write { path: name, message: e.to_string() })
+        Ok(model_file::write(path, &self.to_json_string())?)
     }
 }

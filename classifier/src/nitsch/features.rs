@@ -365,13 +365,13 @@ fn compute_features_body<const WIDE: bool>(view: &GridView<'_>, params: &Feature
     soa.horizontal.resize(cols, 0.0);
     soa.edge.resize(rows - 1, [0.0; squares::SQUARE_FIELDS]);
     let (horizontal, edge, ring) = (&mut soa.horizontal, &mut soa.edge, &mut soa.squares);
-    let xyz = [plane.x, plane.y, plane.z];
+    let coords = squares::Coords { xyz: [plane.x, plane.y, plane.z], cols };
     for t0 in (0..inner).step_by(TILE) {
         let tile = t0..(t0 + TILE).min(inner);
-        squares::square_row(xyz, 0, cols, tile.clone(), &mut edge[0], &mut ring[0]);
+        squares::square_row(coords, 0, tile.clone(), &mut edge[0], &mut ring[0]);
         for r in 1..rows - 1 {
-            squares::square_row(xyz, r, cols, tile.clone(), &mut edge[r], &mut ring[r % 2]);
-            squares::horizontal_row(xyz, r, cols, tile.start.max(1) * L - 1..tile.end * L, horizontal);
+            squares::square_row(coords, r, tile.clone(), &mut edge[r], &mut ring[r % 2]);
+            squares::horizontal_row(coords, r, tile.start.max(1) * L - 1..tile.end * L, horizontal);
             let (below, above) = (&ring[(r - 1) % 2], &ring[r % 2]);
             for j in tile.start.max(1)..tile.end {
                 fast_block::<WIDE>(&plane, below, above, horizontal, r, j, j - tile.start, &mut queue, &mut outputs);

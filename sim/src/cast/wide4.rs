@@ -256,22 +256,6 @@ impl Wide4 {
         if self.root_leaf.is_some() || self.nodes.is_empty() {
             return false;
         }
-        if pres.iter().all(|p| p.origin == pres[0].origin) {
-            self.cast_fan_impl::<N, true>(pres, dirs, tris, best, stack)
-        } else {
-            self.cast_fan_impl::<N, false>(pres, dirs, tris, best, stack)
-        }
-    }
-
-    /// [`Wide4::cast_fan`] for one shared origin (`ONE_ORIGIN`) or an origin interval.
-    fn cast_fan_impl<const N: usize, const ONE_ORIGIN: bool>(
-        &self,
-        pres: &[RayPre; N],
-        dirs: &[Vec3; N],
-        tris: &[[Vec3; 3]],
-        best: &mut [Option<(u32, f32)>; N],
-        stack: &mut Vec<(u32, f32)>,
-    ) -> bool {
         let inv: [[f32; 3]; N] =
             std::array::from_fn(|r| [safe_inv(dirs[r].x), safe_inv(dirs[r].y), safe_inv(dirs[r].z)]);
         let mut i_lo = [f32::INFINITY; 3];
@@ -288,11 +272,33 @@ impl Wide4 {
         }
         let o_lo = pres.iter().fold(Vec3::INFINITY, |m, p| m.min(p.origin)).to_array();
         let o_hi = pres.iter().fold(Vec3::NEG_INFINITY, |m, p| m.max(p.origin)).to_array();
-        let fan = Fan { o_lo, o_hi, i_lo, i_hi };
         let near: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] < 0.0) * 3);
         let far: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] >= 0.0) * 3);
-        let rbs: [RayBox; N] =
-            std::array::from_fn(|r| RayBox { origin: pres[r].origin.to_array(), inv_dir: inv[r], near, far });
+        let walk = FanWalk {
+            fan: Fan { o_lo, o_hi, i_lo, i_hi },
+            rays: std::array::from_fn(|r| RayBox { origin: pres[r].origin.to_array(), inv_dir: inv[r], near, far }),
+            near,
+            far,
+        };
+        if pres.iter().all(|p| p.origin == pres[0].origin) {
+            self.walk_fan::<N, true>(&walk, pres, tris, best, stack);
+        } else {
+            self.walk_fan::<N, false>(&walk, pres, tris, best, stack);
+        }
+        true
+    }
+
+    /// The traversal of [`Wide4::cast_fan`] for one shared origin (`ONE_ORIGIN`) or an origin
+    /// interval.
+    fn walk_fan<const N: usize, const ONE_ORIGIN: bool>(
+        &self,
+        walk: &FanWalk<N>,
+        pres: &[RayPre; N],
+        tris: &[[Vec3; 3]],
+        best: &mut [Option<(u32, f32)>; N],
+        stack: &mut Vec<(u32, f32)>,
+    ) {
+        let FanWalk { fan, rays: rbs, near, far } = walk;
         let mut best_t = [0.0f32; N];
         for r in 0..N {
             best_t[r] = best[r].map_or(pres[r].t_max, |s| s.1);
@@ -302,7 +308,7 @@ impl Wide4 {
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let (t_near, hit) = slab4_fan::<ONE_ORIGIN>(n, &fan, &near, &far, far_t);
+            let (t_near, hit) = slab4_fan::<ONE_ORIGIN>(n, fan, near, far, far_t);
             let (order, m) = nearest_first(&t_near, &hit);
             let mut inner = [(0u32, 0.0f32); 4];
             let mut q = 0;
@@ -325,10 +331,19 @@ impl Wide4 {
             }
             match next_node(&inner[..q], stack, far_t) {
                 Some(c) => node = c,
-                None => return true,
+                None => return,
             }
         }
     }
+}
+
+/// A fan of `N` rays set up for [`Wide4::cast_fan`]'s traversal: its extent, each ray's slab setup,
+/// and the near and far bound of each axis (the same for every ray of the fan).
+struct FanWalk<const N: usize> {
+    fan: Fan,
+    rays: [RayBox; N],
+    near: [usize; 3],
+    far: [usize; 3],
 }
 
 /// The extent of a fan of rays: origins and inverse directions per axis.

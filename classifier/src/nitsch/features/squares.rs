@@ -62,6 +62,16 @@ impl Default for SquareRow {
     }
 }
 
+/// The plane's coordinates as the square and edge rows read them: `x`, `y`, `z`, each row-major in
+/// rows of `cols`.
+#[derive(Clone, Copy)]
+pub(super) struct Coords<'a> {
+    /// `x`, `y` and `z` of every cell.
+    pub(super) xyz: [&'a [f32]; 3],
+    /// Cells per row.
+    pub(super) cols: usize,
+}
+
 /// `L` consecutive values of `a` from `i` on.
 #[inline(always)]
 fn at(a: &[f32], i: usize) -> [f32; L] {
@@ -87,20 +97,20 @@ pub(super) fn inner_chunks(cols: usize) -> usize {
 }
 
 /// Fills `out` with the triangles and edge lengths of the squares between rows `s` and `s + 1` of
-/// the plane (the coordinates `x`, `y`, `z`, each row-major) over the chunks `chunks` (at most
+/// the plane (`coords`) over the chunks `chunks` (at most
 /// [`TILE`]). `edge` holds the last square of the chunk before `chunks` (lane `LEAD - 1`) and gets
 /// the last square of `chunks`. Squares with a corner without a return get meaningless values; the
 /// fast path never reads them. Needs `chunks.end <= inner_chunks(cols)` and `s + 1` a row of the
 /// plane.
 #[inline(always)]
 pub(super) fn square_row(
-    [xs, ys, zs]: [&[f32]; 3],
+    coords: Coords<'_>,
     s: usize,
-    cols: usize,
     chunks: std::ops::Range<usize>,
     edge: &mut [f32; SQUARE_FIELDS],
     out: &mut SquareRow,
 ) {
+    let Coords { xyz: [xs, ys, zs], cols } = coords;
     assert!(chunks.len() <= TILE, "a tile has at most TILE chunks");
     let o = &mut out.0;
     for (jj, j) in chunks.clone().enumerate() {
@@ -138,13 +148,8 @@ pub(super) fn square_row(
 /// Sets `out[c]` to the length of the horizontal edge `|P(r, c + 1) - P(r, c)|` of row `r` for the
 /// columns `c` of `range` (`range.end < cols`).
 #[inline(always)]
-pub(super) fn horizontal_row(
-    [xs, ys, zs]: [&[f32]; 3],
-    r: usize,
-    cols: usize,
-    range: std::ops::Range<usize>,
-    out: &mut [f32],
-) {
+pub(super) fn horizontal_row(coords: Coords<'_>, r: usize, range: std::ops::Range<usize>, out: &mut [f32]) {
+    let Coords { xyz: [xs, ys, zs], cols } = coords;
     let row = r * cols..(r + 1) * cols;
     let (x, y, z) = (&xs[row.clone()], &ys[row.clone()], &zs[row]);
     for c in range {
@@ -212,49 +217,49 @@ pub(super) fn dense_block<const WIDE: bool>(
         }
     }
     let mut acc = Acc::default();
+    let chunk = ChunkPairs { below, above, jj, len: &len, ok: &ok };
     if WIDE {
         // All lanes at once (AVX-512: the 7 sums of 16 lanes stay in 7 of its 32 registers).
-        pairs::<0, L>(below, above, jj, &len, &ok, &mut acc);
+        pairs::<0, L>(chunk, &mut acc);
     } else {
         // Half the lanes at a time: the half's sums stay in registers over the 8 pairs (AVX2's 16
         // registers do not hold the sums of all 16 lanes).
-        pairs::<0, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
-        pairs::<{ L / 2 }, { L / 2 }>(below, above, jj, &len, &ok, &mut acc);
+        pairs::<0, { L / 2 }>(chunk, &mut acc);
+        pairs::<{ L / 2 }, { L / 2 }>(chunk, &mut acc);
     }
     acc
 }
 
+/// What the pairs of [`dense_block`] read: the square rows `below` and `above` the cells, the
+/// chunk's index `jj` in them, and per neighbour `k` its distance `len[k]` and whether it passes the
+/// tests (`ok[k]`, 1 or 0).
+#[derive(Clone, Copy)]
+struct ChunkPairs<'a> {
+    below: &'a SquareRow,
+    above: &'a SquareRow,
+    jj: usize,
+    len: &'a [[f32; L]; 8],
+    ok: &'a [[f32; L]; 8],
+}
+
 /// The 8 pairs of [`dense_block`], in order, for the lanes `H .. H + W`.
 #[inline(always)]
-fn pairs<const H: usize, const W: usize>(
-    below: &SquareRow,
-    above: &SquareRow,
-    jj: usize,
-    len: &[[f32; L]; 8],
-    ok: &[[f32; L]; 8],
-    acc: &mut Acc,
-) {
-    pair::<0, H, W>(below, above, jj, len, ok, acc);
-    pair::<1, H, W>(below, above, jj, len, ok, acc);
-    pair::<2, H, W>(below, above, jj, len, ok, acc);
-    pair::<3, H, W>(below, above, jj, len, ok, acc);
-    pair::<4, H, W>(below, above, jj, len, ok, acc);
-    pair::<5, H, W>(below, above, jj, len, ok, acc);
-    pair::<6, H, W>(below, above, jj, len, ok, acc);
-    pair::<7, H, W>(below, above, jj, len, ok, acc);
+fn pairs<const H: usize, const W: usize>(chunk: ChunkPairs<'_>, acc: &mut Acc) {
+    pair::<0, H, W>(chunk, acc);
+    pair::<1, H, W>(chunk, acc);
+    pair::<2, H, W>(chunk, acc);
+    pair::<3, H, W>(chunk, acc);
+    pair::<4, H, W>(chunk, acc);
+    pair::<5, H, W>(chunk, acc);
+    pair::<6, H, W>(chunk, acc);
+    pair::<7, H, W>(chunk, acc);
 }
 
 /// Pair `K` of [`dense_block`] for the lanes `H .. H + W` (constants, so the triangle's fields
 /// are constant offsets).
 #[inline(always)]
-fn pair<const K: usize, const H: usize, const W: usize>(
-    below: &SquareRow,
-    above: &SquareRow,
-    jj: usize,
-    len: &[[f32; L]; 8],
-    ok: &[[f32; L]; 8],
-    acc: &mut Acc,
-) {
+fn pair<const K: usize, const H: usize, const W: usize>(chunk: ChunkPairs<'_>, acc: &mut Acc) {
+    let ChunkPairs { below, above, jj, len, ok } = chunk;
     let (up, t, back) = PAIR_TRIANGLE[K];
     let chunk = if up { above } else { below };
     let field = |f: usize| window(chunk, f, jj, back);

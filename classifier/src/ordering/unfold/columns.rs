@@ -79,66 +79,21 @@ pub(crate) struct ColumnScratch {
     moved: Vec<i32>,
 }
 
-/// The whole columns (in `[0, cols)`) of one ring's points in a full-turn grid, from their
-/// azimuths and distances, into `out`; the scan goes down the columns when `dir` (the turn's
-/// direction) is +1. Returns whether the ring's columns span a full turn, so that two of its
-/// points may share a column.
-pub(crate) fn ring_columns(
-    rows: &TableRows,
-    row: usize,
-    az: &[f32],
-    dist: &[f32],
-    dir: f32,
-    scratch: &mut ColumnScratch,
-    out: &mut [u32],
-) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if crate::cpu::avx512() {
-        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
-        #[allow(unsafe_code)]
-        unsafe {
-            return ring_columns_avx512(rows, row, az, dist, dir, scratch, out);
-        }
-    }
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2 (checked just above).
-        #[allow(unsafe_code)]
-        unsafe {
-            return ring_columns_avx2(rows, row, az, dist, dir, scratch, out);
-        }
-    }
-    ring_columns_body(rows, row, az, dist, dir, scratch, out)
-}
-
-/// [`ring_columns_body`] compiled for AVX2 (plain IEEE operations: the same columns).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn ring_columns_avx2(
-    rows: &TableRows,
-    row: usize,
-    az: &[f32],
-    dist: &[f32],
-    dir: f32,
-    scratch: &mut ColumnScratch,
-    out: &mut [u32],
-) -> bool {
-    ring_columns_body(rows, row, az, dist, dir, scratch, out)
-}
-
-/// [`ring_columns_body`] compiled for AVX-512 ([`crate::cpu::avx512`]) (plain IEEE operations: the same columns).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
-fn ring_columns_avx512(
-    rows: &TableRows,
-    row: usize,
-    az: &[f32],
-    dist: &[f32],
-    dir: f32,
-    scratch: &mut ColumnScratch,
-    out: &mut [u32],
-) -> bool {
-    ring_columns_body(rows, row, az, dist, dir, scratch, out)
+crate::cpu::dispatch_by_isa! {
+    /// The whole columns (in `[0, cols)`) of one ring's points in a full-turn grid, from their
+    /// azimuths and distances, into `out`; the scan goes down the columns when `dir` (the turn's
+    /// direction) is +1. Returns whether the ring's columns span a full turn, so that two of its
+    /// points may share a column.
+    pub(crate) fn ring_columns(
+        rows: &TableRows,
+        row: usize,
+        az: &[f32],
+        dist: &[f32],
+        dir: f32,
+        scratch: &mut ColumnScratch,
+        out: &mut [u32],
+    ) -> bool;
+    body: ring_columns_body, avx2: "avx2" if std::arch::is_x86_feature_detected!("avx2")
 }
 
 /// The body of [`ring_columns`], inlined into each instruction-set variant.

@@ -117,59 +117,18 @@ fn next_flagged(flags: &[u8], mut j: usize) -> usize {
     j
 }
 
-/// Splits the usable points (file order; `az` their azimuths, `fine` their `tan(elevation)` from
-/// their nearest beam's origin) into rings; returns the start of each ring, or why the order does
-/// not unfold, with the direction of the turn (+1 counter-clockwise).
-pub(crate) fn ring_starts(
-    az: &[f32],
-    dist: &[f32],
-    fine: &[f32],
-    rows: &TableRows,
-    params: &UnfoldParams,
-) -> Result<(Vec<usize>, f32), String> {
-    #[cfg(target_arch = "x86_64")]
-    if crate::cpu::avx512() {
-        // SAFETY: the CPU supports AVX-512 F, BW, VL and DQ, AVX2, BMI1 and BMI2 (checked just above).
-        #[allow(unsafe_code)]
-        unsafe {
-            return ring_starts_avx512(az, dist, fine, rows, params);
-        }
-    }
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2 (checked just above).
-        #[allow(unsafe_code)]
-        unsafe {
-            return ring_starts_avx2(az, dist, fine, rows, params);
-        }
-    }
-    ring_starts_body(az, dist, fine, rows, params)
-}
-
-/// [`ring_starts_body`] compiled for AVX2 (plain IEEE operations: the same rings).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn ring_starts_avx2(
-    az: &[f32],
-    dist: &[f32],
-    fine: &[f32],
-    rows: &TableRows,
-    params: &UnfoldParams,
-) -> Result<(Vec<usize>, f32), String> {
-    ring_starts_body(az, dist, fine, rows, params)
-}
-
-/// [`ring_starts_body`] compiled for AVX-512 ([`crate::cpu::avx512`]) (plain IEEE operations: the same rings).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
-fn ring_starts_avx512(
-    az: &[f32],
-    dist: &[f32],
-    fine: &[f32],
-    rows: &TableRows,
-    params: &UnfoldParams,
-) -> Result<(Vec<usize>, f32), String> {
-    ring_starts_body(az, dist, fine, rows, params)
+crate::cpu::dispatch_by_isa! {
+    /// Splits the usable points (file order; `az` their azimuths, `fine` their `tan(elevation)` from
+    /// their nearest beam's origin) into rings; returns the start of each ring, or why the order does
+    /// not unfold, with the direction of the turn (+1 counter-clockwise).
+    pub(crate) fn ring_starts(
+        az: &[f32],
+        dist: &[f32],
+        fine: &[f32],
+        rows: &TableRows,
+        params: &UnfoldParams,
+    ) -> Result<(Vec<usize>, f32), String>;
+    body: ring_starts_body, avx2: "avx2" if std::arch::is_x86_feature_detected!("avx2")
 }
 
 /// The body of [`ring_starts`], inlined into each instruction-set variant.
