@@ -54,8 +54,8 @@ done
 echo "]," >> "$out"
 
 log "scan: $(n 100) moving os1-128-roof city frames, kitti"
-scan_gpu=$(wall "$BIN" scan --scene city --rig os1-128-roof --frames "$(n 100)" --speed 10 --format kitti --backend gpu --out "$work/scan-gpu")
-scan_bvh=$(wall "$BIN" scan --scene city --rig os1-128-roof --frames "$(n 100)" --speed 10 --format kitti --backend bvh --out "$work/scan-bvh")
+scan_gpu=$(wall "$BIN" scan --scene city --rig os1-128-roof --frames "$(n 100)" --speed-m-per-s 10 --format kitti --backend gpu --out "$work/scan-gpu")
+scan_bvh=$(wall "$BIN" scan --scene city --rig os1-128-roof --frames "$(n 100)" --speed-m-per-s 10 --format kitti --backend bvh --out "$work/scan-bvh")
 echo "\"scan_s\": {\"frames\": $(n 100), \"gpu\": $scan_gpu, \"bvh\": $scan_bvh}," >> "$out"
 
 frames=$(n 100)

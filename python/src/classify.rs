@@ -7,11 +7,10 @@ use std::sync::Arc;
 use classifier::{FrameInput, GroundClassifier};
 use groundtruth_scenario::Scan;
 use pyo3::prelude::*;
-use pyo3::types::{PyList, PyTuple};
+use pyo3::types::PyList;
 
-use crate::args::type_name;
-use crate::error::{classify_error, type_error, value_error};
-use crate::frame::{Frame, grid_array};
+use crate::error::{classify_error, value_error};
+use crate::frame::{frames_arg, grid_array};
 
 /// A method that could not be resolved, as a Python exception naming what is wrong: `ValueError`
 /// for an unknown name or a model given to a method that takes none, `FileNotFoundError` for a
@@ -52,25 +51,7 @@ pub fn classify<'py>(
     model: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut m = self::method(method, model.as_ref())?;
-    let single = frame.cast::<Frame>().is_ok();
-    let frames: Vec<Bound<'py, Frame>> = if single {
-        vec![frame.cast::<Frame>()?.clone()]
-    } else if frame.is_instance_of::<PyList>() || frame.is_instance_of::<PyTuple>() {
-        frame
-            .try_iter()?
-            .map(|f| {
-                let f = f?;
-                f.cast_into::<Frame>().map_err(|e| {
-                    type_error(
-                        "frame",
-                        format!("expected a list of Frames, got one holding {}", type_name(e.into_inner().as_any())),
-                    )
-                })
-            })
-            .collect::<PyResult<_>>()?
-    } else {
-        return Err(type_error("frame", format!("expected a Frame or a list of Frames, got {}", type_name(frame))));
-    };
+    let (frames, single) = frames_arg(frame, "a Frame or a list of Frames")?;
     let work: Vec<(Arc<Scan>, usize)> = frames.iter().map(|f| (f.get().scan.clone(), f.get().k)).collect();
     let decisions = py
         .detach(move || {

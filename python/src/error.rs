@@ -37,7 +37,9 @@ pub fn scenario_error(e: ScenarioError) -> PyErr {
     match e {
         ScenarioError::Io { ref source, .. } => io_error(source, e.to_string()),
         ScenarioError::Sim(s) => sim_error(s),
-        ScenarioError::Scene(scenes::SceneError::Io { ref source, .. }) => io_error(source, e.to_string()),
+        ScenarioError::Scene(scenes::SceneError::Sim(sim::SimError::Io { ref source, .. })) => {
+            io_error(source, e.to_string())
+        }
         e => PyValueError::new_err(e.to_string()),
     }
 }

@@ -11,10 +11,11 @@ use std::sync::Arc;
 use groundtruth_scenario::{Region, Scan};
 use numpy::{Element, PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList, PyTuple};
 use sim::OrderedCloud;
 
-use crate::error::scenario_error;
+use crate::args::type_name;
+use crate::error::{scenario_error, type_error};
 use crate::score::parse_region;
 
 /// One frame of a scan, or a file read back: the labelled ordered cloud as numpy arrays.
@@ -41,6 +42,29 @@ impl Frame {
         let c = self.cloud();
         (c.planes * c.rows, c.cols)
     }
+}
+
+/// The frames of a `frame` argument and whether it was a single Frame (else a list or tuple of
+/// Frames); anything else is a `TypeError` naming `frame` that says it expected `expected`.
+pub fn frames_arg<'py>(frame: &Bound<'py, PyAny>, expected: &str) -> PyResult<(Vec<Bound<'py, Frame>>, bool)> {
+    if let Ok(f) = frame.cast::<Frame>() {
+        return Ok((vec![f.clone()], true));
+    }
+    if !(frame.is_instance_of::<PyList>() || frame.is_instance_of::<PyTuple>()) {
+        return Err(type_error("frame", format!("expected {expected}, got {}", type_name(frame))));
+    }
+    let frames = frame
+        .try_iter()?
+        .map(|f| {
+            f?.cast_into::<Frame>().map_err(|e| {
+                type_error(
+                    "frame",
+                    format!("expected {expected}, got a list holding {}", type_name(e.into_inner().as_any())),
+                )
+            })
+        })
+        .collect::<PyResult<_>>()?;
+    Ok((frames, false))
 }
 
 /// `v` (one entry per cell, grid order) as an array of shape `(h, w)` or `(h, w, depth)`.

@@ -25,82 +25,6 @@ use crate::frame::Frame;
 /// The largest number of frames of one `scan` call.
 const MAX_FRAMES: u64 = sim::scan::MAX_FRAMES as u64;
 
-/// `scan()`'s keyword arguments beyond scene and rig.
-struct ScanKwargs<'py> {
-    params: Option<Bound<'py, PyDict>>,
-    mount: Option<Bound<'py, PyDict>>,
-    seed: Option<Bound<'py, PyAny>>,
-    frames: Option<Bound<'py, PyAny>>,
-    speed_m_per_s: Option<Bound<'py, PyAny>>,
-    yaw_rate_deg_per_s: Option<Bound<'py, PyAny>>,
-    waypoints_m: Option<Vec<(f64, f64)>>,
-    ideal: bool,
-    noise_scale: Option<Bound<'py, PyAny>>,
-    dropout: Option<Bound<'py, PyAny>>,
-    intensity_scale: Option<Bound<'py, PyAny>>,
-    weather: Option<String>,
-    speed: Option<Bound<'py, PyAny>>,
-    rest: Option<Bound<'py, PyDict>>,
-}
-
-/// Builds the scenario of `scan()`'s arguments: every value checked with its field named, the
-/// ranges by the scan spec (the same messages as a spec file, a dataset or sweep file, the command
-/// line and the Rust builder).
-fn scenario(py: Python<'_>, scene: &str, rig: &str, a: ScanKwargs<'_>) -> PyResult<groundtruth_scenario::Scenario> {
-    if let Some(rest) = &a.rest
-        && let Some((k, _)) = rest.iter().next()
-    {
-        let key: String = k.extract()?;
-        return Err(scenario_error(groundtruth_scenario::spec::key_error(&key, "scan()")));
-    }
-    let mut s = with_rig(scene_scenario(scene)?, rig)?;
-    if let Some(p) = &a.params {
-        s = with_params(s, p)?;
-    }
-    if let Some(m) = &a.mount {
-        s = with_mount(s, m)?;
-    }
-    if let Some(v) = &a.speed {
-        PyErr::warn(
-            py,
-            py.get_type::<pyo3::exceptions::PyDeprecationWarning>().as_any(),
-            c"scan(speed=...) is deprecated: use speed_m_per_s (the same metres per second)",
-            1,
-        )?;
-        s = s.speed_m_per_s(finite_f64(v, "speed")? as f32);
-    }
-    if let Some(v) = &a.speed_m_per_s {
-        s = s.speed_m_per_s(finite_f64(v, "speed_m_per_s")? as f32);
-    }
-    if let Some(v) = &a.yaw_rate_deg_per_s {
-        s = s.yaw_rate_deg_per_s(finite_f64(v, "yaw_rate_deg_per_s")?);
-    }
-    if let Some(w) = a.waypoints_m {
-        s = s.waypoints_m(w.into_iter().map(|(x, y)| [x, y]).collect());
-    }
-    if let Some(v) = &a.noise_scale {
-        s = s.noise_scale(finite_f64(v, "noise_scale")?);
-    }
-    if let Some(v) = &a.dropout {
-        s = s.dropout(finite_f64(v, "dropout")?);
-    }
-    if let Some(v) = &a.intensity_scale {
-        s = s.intensity_scale(finite_f64(v, "intensity_scale")?);
-    }
-    if let Some(spec) = &a.weather {
-        s = s.weather(sim::effects::weather::Weather::parse(spec).map_err(crate::error::sim_error)?);
-    }
-    if let Some(v) = &a.seed {
-        s = s.seed(uint(v, "seed", 0, u64::MAX)?);
-    }
-    if let Some(v) = &a.frames {
-        s = s.frames(uint(v, "frames", 1, MAX_FRAMES)? as usize);
-    }
-    let s = s.ideal(a.ideal);
-    s.spec().validate().map_err(scenario_error)?;
-    Ok(s)
-}
-
 /// Scans a scene with a rig and returns the frames (a list of `Frame`).
 ///
 /// `scene`: a bundled scene (`groundtruth.SCENES`), a simulator built-in (`flat-objects`) or
@@ -141,23 +65,59 @@ fn scan<'py>(
     speed: Option<Bound<'py, PyAny>>,
     rest: Option<Bound<'py, PyDict>>,
 ) -> PyResult<Vec<Frame>> {
-    let kwargs = ScanKwargs {
-        params,
-        mount,
-        seed,
-        frames,
-        speed_m_per_s,
-        yaw_rate_deg_per_s,
-        waypoints_m,
-        ideal,
-        noise_scale,
-        dropout,
-        intensity_scale,
-        weather,
-        speed,
-        rest,
-    };
-    let s = scenario(py, scene, rig, kwargs)?;
+    // Every value checked with its field named, the ranges by the scan spec (the same messages as
+    // a spec file, a dataset or sweep file, the command line and the Rust builder).
+    if let Some(rest) = &rest
+        && let Some((k, _)) = rest.iter().next()
+    {
+        let key: String = k.extract()?;
+        return Err(scenario_error(groundtruth_scenario::spec::key_error(&key, "scan()")));
+    }
+    let mut s = with_rig(scene_scenario(scene)?, rig)?;
+    if let Some(p) = &params {
+        s = with_params(s, p)?;
+    }
+    if let Some(m) = &mount {
+        s = with_mount(s, m)?;
+    }
+    if let Some(v) = &speed {
+        PyErr::warn(
+            py,
+            py.get_type::<pyo3::exceptions::PyDeprecationWarning>().as_any(),
+            c"scan(speed=...) is deprecated: use speed_m_per_s (the same metres per second)",
+            1,
+        )?;
+        s = s.speed_m_per_s(finite_f64(v, "speed")? as f32);
+    }
+    if let Some(v) = &speed_m_per_s {
+        s = s.speed_m_per_s(finite_f64(v, "speed_m_per_s")? as f32);
+    }
+    if let Some(v) = &yaw_rate_deg_per_s {
+        s = s.yaw_rate_deg_per_s(finite_f64(v, "yaw_rate_deg_per_s")?);
+    }
+    if let Some(w) = waypoints_m {
+        s = s.waypoints_m(w.into_iter().map(|(x, y)| [x, y]).collect());
+    }
+    if let Some(v) = &noise_scale {
+        s = s.noise_scale(finite_f64(v, "noise_scale")?);
+    }
+    if let Some(v) = &dropout {
+        s = s.dropout(finite_f64(v, "dropout")?);
+    }
+    if let Some(v) = &intensity_scale {
+        s = s.intensity_scale(finite_f64(v, "intensity_scale")?);
+    }
+    if let Some(spec) = &weather {
+        s = s.weather(sim::effects::weather::Weather::parse(spec).map_err(crate::error::sim_error)?);
+    }
+    if let Some(v) = &seed {
+        s = s.seed(uint(v, "seed", 0, u64::MAX)?);
+    }
+    if let Some(v) = &frames {
+        s = s.frames(uint(v, "frames", 1, MAX_FRAMES)? as usize);
+    }
+    let s = s.ideal(ideal);
+    s.spec().validate().map_err(scenario_error)?;
     let scan = Arc::new(py.detach(move || s.scan()).map_err(scenario_error)?);
     Ok((0..scan.frames().len()).map(|k| Frame { scan: scan.clone(), k }).collect())
 }

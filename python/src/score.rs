@@ -8,7 +8,7 @@ use pyo3::types::{PyDict, PyList, PyTuple};
 
 use crate::args::type_name;
 use crate::error::{scenario_error, type_error, value_error};
-use crate::frame::Frame;
+use crate::frame::{Frame, frames_arg};
 
 /// Every region name `parse_region` takes without an argument.
 pub const REGIONS: [&str; 12] = [
@@ -238,27 +238,12 @@ pub fn cell_decisions(frame: &Frame, decisions: &Bound<'_, PyAny>) -> PyResult<V
 #[pyo3(signature = (frame, decisions, region=None))]
 pub fn score(frame: &Bound<'_, PyAny>, decisions: &Bound<'_, PyAny>, region: Option<&str>) -> PyResult<Score> {
     let region = parse_region(region.unwrap_or("all"))?;
-    if let Ok(f) = frame.cast::<Frame>() {
-        let f = f.get();
+    let (frames, single) = frames_arg(frame, "a Frame, or a list of the Frames of one scan")?;
+    if single {
+        let f = frames[0].get();
         let d = cell_decisions(f, decisions)?;
         return Ok(Score(f.scan.score_frame(f.k, &region, &d).map_err(scenario_error)?));
     }
-    let expected = "a Frame, or a list of the Frames of one scan";
-    if !(frame.is_instance_of::<PyList>() || frame.is_instance_of::<PyTuple>()) {
-        return Err(type_error("frame", format!("expected {expected}, got {}", type_name(frame))));
-    }
-    let frames: Vec<Bound<'_, Frame>> = frame
-        .try_iter()?
-        .map(|f| {
-            let f = f?;
-            f.cast_into::<Frame>().map_err(|e| {
-                type_error(
-                    "frame",
-                    format!("expected {expected}, got a list holding {}", type_name(e.into_inner().as_any())),
-                )
-            })
-        })
-        .collect::<PyResult<_>>()?;
     let Some(first) = frames.first() else {
         return Err(value_error("frame", "an empty list"));
     };

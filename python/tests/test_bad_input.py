@@ -136,7 +136,7 @@ def test_bad_classify(frame, tmp_path):
         gt.classify(frame, 3)
     with pytest.raises(TypeError, match="frame: expected a Frame or a list of Frames, got str"):
         gt.classify("frame.pcd")
-    with pytest.raises(TypeError, match="frame: expected a list of Frames, got one holding int"):
+    with pytest.raises(TypeError, match="frame: expected a Frame or a list of Frames, got a list holding int"):
         gt.classify([frame, 1])
 
 

@@ -58,14 +58,9 @@ pub enum SceneError {
         /// What went wrong.
         message: String,
     },
-    /// The scene file itself could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Underlying error.
-        source: std::io::Error,
-    },
+    /// The scene file itself could not be read ([`sim::SimError::Io`], naming the file).
+    #[error(transparent)]
+    Sim(#[from] sim::SimError),
 }
 
 impl SceneError {

@@ -104,7 +104,7 @@ pub fn load(name_or_path: &str, seed: u64) -> Result<Scene, SceneError> {
 
 /// Generates a scene from a TOML file; user mesh paths resolve against the file's directory.
 pub fn load_file(path: &Path, seed: u64) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|source| sim::SimError::io(path, source))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let mut scene = load_str(&text, &path.display().to_string(), &dir, seed)?;

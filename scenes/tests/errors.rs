@@ -80,7 +80,10 @@ fn unknown_family_and_scene_list_the_known_ones() {
     assert!(matches!(e, SceneError::UnknownScene { .. }));
     assert!(e.to_string().contains("ramp-up") && e.to_string().contains("elevated"), "{e}");
     let e = scenes::load("/does/not/exist.toml", 0).unwrap_err();
-    assert!(matches!(e, SceneError::Io { .. }) && e.to_string().contains("/does/not/exist.toml"), "{e}");
+    assert!(
+        matches!(e, SceneError::Sim(sim::SimError::Io { .. })) && e.to_string().contains("/does/not/exist.toml"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -9,8 +9,12 @@ use anyhow::Context;
 use groundtruth_scenario::{ScanBackend, ScanSetup, ScanSpec};
 use sim::scan::{Agreement, AgreementContract, Scanner};
 
+/// The ego speed of `bench agreement` without `--speed-m-per-s`, metres per second (the flag's help says it).
+pub const DEFAULT_SPEED_M_PER_S: f32 = 10.0;
+
 /// Arguments of `groundtruth bench agreement`.
 #[derive(clap::Args, Debug)]
+#[command(mut_arg("speed_m_per_s", |a| a.help("Ego speed, metres per second (0: a standing vehicle, whose rays stay on the device; default 10)")))]
 pub struct Args {
     /// Scene name or TOML file.
     #[arg(long, default_value = "city")]
@@ -24,9 +28,9 @@ pub struct Args {
     /// Seed of the scene and of the measurement noise.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Ego speed, metres per second (0: a standing vehicle, whose rays stay on the device).
-    #[arg(long, default_value_t = 10.0)]
-    pub speed: f32,
+    /// Ego speed (`--speed-m-per-s`).
+    #[command(flatten)]
+    pub speed: super::common::SpeedArgs,
     /// Measurement effects off (exact distances).
     #[arg(long)]
     pub ideal: bool,
@@ -43,12 +47,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if !(1..=1000).contains(&args.frames) {
         anyhow::bail!("invalid value for `--frames`: {} (allowed: 1 ..= 1000)", args.frames);
     }
+    let speed_m_per_s = args.speed.or(DEFAULT_SPEED_M_PER_S);
     let spec = ScanSpec {
         scene: args.scene.clone(),
         rig: args.rig.clone(),
         seed: args.seed,
         frames: args.frames as u64,
-        speed_m_per_s: f64::from(args.speed),
+        speed_m_per_s: f64::from(speed_m_per_s),
         ideal: args.ideal,
         ..ScanSpec::default()
     };
@@ -79,7 +84,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "scene": args.scene,
         "rig": args.rig,
         "frames": args.frames,
-        "speed_m_per_s": args.speed,
+        "speed_m_per_s": speed_m_per_s,
         "ideal": args.ideal,
         "backend": args.backend,
         "reference": args.reference,

@@ -3,7 +3,7 @@
 //!
 //! Bare: the frame's rays, generated beforehand, cast with `cast_batch` per row in parallel. Full:
 //! `Scanner::frame_into` into a reused cloud. A standing vehicle's rays are the same in every frame,
-//! so the scanner builds them once (in `Scanner::new`); `--speed` makes the vehicle move so that
+//! so the scanner builds them once (in `Scanner::new`); `--speed-m-per-s` makes the vehicle move so that
 //! every full frame builds its rays at each shot's own pose.
 
 use std::time::Instant;
@@ -14,8 +14,12 @@ use rayon::prelude::*;
 use sim::cast::Hit;
 use sim::scan::Scanner;
 
+/// The ego speed of `bench scan` without `--speed-m-per-s`, metres per second (the flag's help says it).
+pub const DEFAULT_SPEED_M_PER_S: f32 = 0.0;
+
 /// Arguments of `groundtruth bench scan`.
 #[derive(clap::Args, Debug)]
+#[command(mut_arg("speed_m_per_s", |a| a.help("Ego speed, metres per second (0: a standing vehicle; default 0)")))]
 pub struct Args {
     /// Scene name or TOML file.
     #[arg(long, default_value = "flat-objects")]
@@ -32,9 +36,9 @@ pub struct Args {
     /// Seed of the scene and the scan.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Ego speed, metres per second (0: a standing vehicle).
-    #[arg(long, default_value_t = 0.0)]
-    pub speed: f32,
+    /// Ego speed (`--speed-m-per-s`).
+    #[command(flatten)]
+    pub speed: super::common::SpeedArgs,
     /// Also time full frames in these weathers (`fog:visibility_m=50 snow:rate_mm_h=2 ...`),
     /// interleaved with the plain frame: `weather[].added` is the share of time they add.
     #[arg(long, num_args = 1..)]
@@ -47,17 +51,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         anyhow::bail!("invalid value for `--frames`: {} (allowed: 1 ..= 1000)", args.frames);
     }
     let threads = args.threads;
-    let json = super::scan::with_threads(threads, || bench(&args))??;
+    let speed_m_per_s = args.speed.or(DEFAULT_SPEED_M_PER_S);
+    let json = super::scan::with_threads(threads, || bench(&args, speed_m_per_s))??;
     println!("{json}");
     Ok(())
 }
 
-fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
+/// The timings of `args`'s scan at `speed_m_per_s` (the flag's value, either spelling).
+fn bench(args: &Args, speed_m_per_s: f32) -> anyhow::Result<serde_json::Value> {
     let spec = ScanSpec {
         scene: args.scene.clone(),
         rig: args.rig.clone(),
         seed: args.seed,
-        speed_m_per_s: f64::from(args.speed),
+        speed_m_per_s: f64::from(speed_m_per_s),
         ..ScanSpec::default()
     };
     let scene = spec.load_scene().with_context(|| format!("loading scene `{}`", args.scene))?;
@@ -127,7 +133,7 @@ fn bench(args: &Args) -> anyhow::Result<serde_json::Value> {
         "rig": args.rig,
         "triangles": scene.mesh.len(),
         "threads": rayon::current_num_threads(),
-        "speed_m_per_s": args.speed,
+        "speed_m_per_s": speed_m_per_s,
         "rays": rays,
         "returns": returns,
         "setup_s": setup_s,

@@ -1,4 +1,5 @@
-//! Shared helpers of the subcommands: resolving scene and rig names or files, and parsing lists.
+//! Shared helpers of the subcommands: resolving scene and rig names or files, parsing lists, and the
+//! deprecated spellings of flags.
 
 use anyhow::Context;
 use groundtruth_scenario::ScanSpec;
@@ -39,6 +40,35 @@ pub fn scan_spec(spec: &ScanSpec) -> anyhow::Result<Vec<sim::scan::Frame>> {
         spec.vary(&mut f.cloud, f.index)?;
     }
     Ok(frames)
+}
+
+/// The ego speed given as `--speed-m-per-s` or as its deprecated spelling `--speed` (the same metres
+/// per second; clap refuses both together), which says so on stderr; `None` when neither was given.
+pub fn speed_m_per_s<T>(speed_m_per_s: Option<T>, deprecated_speed: Option<T>) -> Option<T> {
+    if deprecated_speed.is_some() {
+        eprintln!("warning: --speed is deprecated, use --speed-m-per-s (the same metres per second)");
+    }
+    speed_m_per_s.or(deprecated_speed)
+}
+
+/// The ego speed flag of the commands that scan with a default speed of their own (`demo`,
+/// `bench scan`, `bench agreement`): `--speed-m-per-s`, and `--speed`, its deprecated spelling.
+/// A command states its default in the flag's help (`mut_arg`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct SpeedArgs {
+    /// Ego speed, metres per second.
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "speed")]
+    pub speed_m_per_s: Option<f32>,
+    /// Deprecated spelling of --speed-m-per-s (metres per second); removed in the next release.
+    #[arg(long, allow_negative_numbers = true, hide = true)]
+    pub speed: Option<f32>,
+}
+
+impl SpeedArgs {
+    /// The speed given (either spelling, [`speed_m_per_s`]), else `default`.
+    pub fn or(&self, default: f32) -> f32 {
+        speed_m_per_s(self.speed_m_per_s, self.speed).unwrap_or(default)
+    }
 }
 
 /// Splits a comma-separated list, dropping empty items.

@@ -9,8 +9,12 @@ use classifier::{Evaluation, FrameInput, method_by_name};
 use sim::io::manifest::affine_from_rows;
 use sim::picture::{BevOptions, Coloring, render_bev, save_png};
 
+/// The ego speed of `demo` without `--speed-m-per-s`, metres per second (the flag's help says it).
+pub const DEFAULT_SPEED_M_PER_S: f32 = 5.0;
+
 /// Arguments of `groundtruth demo`.
 #[derive(clap::Args, Debug)]
+#[command(mut_arg("speed_m_per_s", |a| a.help("Ego speed, metres per second (default 5)")))]
 pub struct Args {
     /// Output directory.
     #[arg(long, default_value = "out/demo")]
@@ -27,9 +31,9 @@ pub struct Args {
     /// Frames to scan.
     #[arg(long, default_value_t = 3)]
     pub frames: usize,
-    /// Ego speed, metres per second.
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
-    pub speed: f32,
+    /// Ego speed (`--speed-m-per-s`).
+    #[command(flatten)]
+    pub speed: super::common::SpeedArgs,
     /// Seed of the scene and the noise.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -37,6 +41,7 @@ pub struct Args {
 
 /// Runs the demo.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let speed_m_per_s = args.speed.or(DEFAULT_SPEED_M_PER_S);
     let mut method = method_by_name(&args.method, args.seed)?;
     let scan_dir = args.out.join("scan");
     let class_dir = args.out.join("classified");
@@ -47,7 +52,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         out: scan_dir.clone(),
         seed: args.seed,
         frames: args.frames,
-        speed_m_per_s: Some(f64::from(args.speed)),
+        speed_m_per_s: Some(f64::from(speed_m_per_s)),
         speed: None,
         yaw_rate_deg_per_s: None,
         yaw_rate: None,

@@ -80,3 +80,54 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(c) => bench::run(c),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::{CommandFactory, Parser};
+
+    use super::{Cli, Command, bench, bench_agreement, bench_scan, demo};
+
+    /// The speed that `demo`, `bench scan` and `bench agreement` take from `words`: either spelling,
+    /// else the command's own default.
+    fn speed(words: &[&str]) -> Result<f32, clap::Error> {
+        let cli = Cli::try_parse_from(["groundtruth"].iter().chain(words))?;
+        Ok(match cli.command {
+            Command::Demo(a) => a.speed.or(demo::DEFAULT_SPEED_M_PER_S),
+            Command::Bench(bench::Command::Scan(a)) => a.speed.or(bench_scan::DEFAULT_SPEED_M_PER_S),
+            Command::Bench(bench::Command::Agreement(a)) => a.speed.or(bench_agreement::DEFAULT_SPEED_M_PER_S),
+            other => panic!("not a command with a speed: {other:?}"),
+        })
+    }
+
+    #[test]
+    fn speed_flags_take_the_unit_spelling_and_the_deprecated_one() {
+        Cli::command().debug_assert();
+        let cases = [
+            (&["demo"][..], demo::DEFAULT_SPEED_M_PER_S),
+            (&["bench", "scan"][..], bench_scan::DEFAULT_SPEED_M_PER_S),
+            (&["bench", "agreement"][..], bench_agreement::DEFAULT_SPEED_M_PER_S),
+        ];
+        // The defaults as the help states them.
+        assert_eq!(cases.map(|c| c.1), [5.0, 0.0, 10.0]);
+        for (words, default) in cases {
+            assert_eq!(speed(words).unwrap(), default, "{words:?}");
+            for flag in ["--speed-m-per-s", "--speed"] {
+                let given = [words, &[flag, "-2.5"][..]].concat();
+                assert_eq!(speed(&given).unwrap(), -2.5, "{given:?}");
+            }
+            let both = [words, &["--speed-m-per-s", "1", "--speed", "2"][..]].concat();
+            let e = speed(&both).unwrap_err();
+            assert_eq!(e.kind(), clap::error::ErrorKind::ArgumentConflict, "{both:?}");
+            // The unit spelling shows in the help with the command's default, the old one does not.
+            let sub = Cli::command();
+            let sub = words.iter().fold(sub, |c, w| c.find_subcommand(w).unwrap().clone());
+            let help = sub
+                .get_arguments()
+                .map(|a| (a.get_id().as_str().to_string(), a.is_hide_set(), a.get_help().map(|h| h.to_string())))
+                .collect::<Vec<_>>();
+            let unit = help.iter().find(|(id, ..)| id == "speed_m_per_s").unwrap();
+            assert!(!unit.1 && unit.2.as_deref().unwrap().contains(&format!("default {default}")), "{unit:?}");
+            assert!(help.iter().find(|(id, ..)| id == "speed").unwrap().1, "{words:?}");
+        }
+    }
+}

@@ -135,11 +135,7 @@ impl Args {
             backend: Some(ScanBackend::parse(&self.backend).context("--backend")?),
             ..ScanSpec::default()
         };
-        if let Some(v) = self.speed {
-            eprintln!("warning: --speed is deprecated, use --speed-m-per-s (the same metres per second)");
-            spec.speed_m_per_s = f64::from(v);
-        }
-        if let Some(v) = self.speed_m_per_s {
+        if let Some(v) = super::common::speed_m_per_s(self.speed_m_per_s, self.speed.map(f64::from)) {
             spec.speed_m_per_s = v;
         }
         if let Some(v) = self.yaw_rate {

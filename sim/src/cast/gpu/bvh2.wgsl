@@ -25,10 +25,7 @@ fn enter(lo: vec3<f32>, hi: vec3<f32>, o: vec3<f32>, inv: vec3<f32>, t_best: f32
 fn trace(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<u32> {
     let r = tri_ray(o, d);
     var best = Closest(t_max, MISS);
-    // Slab test: zero components replaced by a tiny one of the same sign (no infinities or NaN).
-    let tiny = vec3<f32>(1.0e-30);
-    let d_safe = select(d, select(tiny, -tiny, d < vec3<f32>(0.0)), abs(d) < tiny);
-    let inv = 1.0 / d_safe;
+    let inv = slab_inv(d);
 
     var stack: array<u32, 64>;
     var sp = 1u;

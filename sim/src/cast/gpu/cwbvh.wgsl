@@ -66,10 +66,7 @@ fn hit_bits(
 fn trace(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<u32> {
     let r = tri_ray(o, d);
     var best = Closest(t_max, MISS);
-    // Slab test: zero components replaced by a tiny one of the same sign (no infinities or NaN).
-    let tiny = vec3<f32>(1.0e-30);
-    let d_safe = select(d, select(tiny, -tiny, d < vec3<f32>(0.0)), abs(d) < tiny);
-    let inv = 1.0 / d_safe;
+    let inv = slab_inv(d);
     // The octant of -d: 4 for x >= 0, 2 for y, 1 for z.
     let oct_inv = select(0u, 4u, !(d.x < 0.0)) | select(0u, 2u, !(d.y < 0.0)) | select(0u, 1u, !(d.z < 0.0));
 

@@ -19,3 +19,11 @@ fn node(n: u32, h: u32) -> vec4<f32> {
     return nodes1[j];
 }
 
+
+// The inverse direction of `d` for the traversals' slab tests: zero components replaced by a tiny
+// one of the same sign (no infinities or NaN).
+fn slab_inv(d: vec3<f32>) -> vec3<f32> {
+    let tiny = vec3<f32>(1.0e-30);
+    let d_safe = select(d, select(tiny, -tiny, d < vec3<f32>(0.0)), abs(d) < tiny);
+    return 1.0 / d_safe;
+}
