@@ -15,8 +15,10 @@
 //!   organized `.bin` (a whole sensor image with `0, 0, 0` no-returns, row by row or column by
 //!   column, as Ouster clouds converted to KITTI files are) is recognised ([`setup`]);
 //!
-//! The beam table comes from a rig, a built-in nominal table, or the sensor's own calibration file
-//! ([`calibration`]: our TOML or text format, the velodyne driver's YAML, Ouster's metadata JSON).
+//! The beam table comes from a rig, the sensor's own calibration file ([`calibration`]: our TOML or
+//! text format, the velodyne driver's YAML, Ouster's metadata JSON), or, without either, from the
+//! data ([`recover`]: the rings and columns a flat cloud shows, the sensor named where its
+//! elevations match a known table; a cloud whose order cannot be recovered is refused).
 //!
 //! Columns come from each point's beam azimuth on every path. Points that share a cell are all kept
 //! ([`placement`]): the adjacent free column on the point's side, else a further plane of the same

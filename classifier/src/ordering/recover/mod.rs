@@ -247,21 +247,14 @@ pub(crate) fn recover<P: InputPoint>(points: &[P]) -> Result<Recovery, RecoveryE
         return Err(RecoveryError::NoOrder { points: n, why: "fewer than 64 usable points".into() });
     }
     let params = UnfoldParams::default();
-    let ring_major = ring_starts(&az, &dist, &tan, provisional_rows(), &params);
-    let (starts, why_not_rings) = match ring_major {
-        Ok((starts, _)) => (Some(starts), String::new()),
-        Err(why) => (None, why),
+    let why_not_rings = match ring_starts(&az, &dist, &tan, provisional_rows(), &params) {
+        Ok((starts, _)) => return Ok(from_rings(&starts, &az, &dist, &tan, index)),
+        Err(why) => why,
     };
-    if let Some(starts) = starts {
-        return Ok(from_rings(&starts, &az, &dist, &tan, index));
-    }
-    match firing::recover_firing(points, usable.as_deref(), &az) {
-        Ok(r) => Ok(r),
-        Err(why) => Err(RecoveryError::NoOrder {
-            points: n,
-            why: format!("not scan order: {why_not_rings}; not firing order: {why}"),
-        }),
-    }
+    firing::recover_firing(points, usable.as_deref(), &az).map_err(|why| RecoveryError::NoOrder {
+        points: n,
+        why: format!("not scan order: {why_not_rings}; not firing order: {why}"),
+    })
 }
 
 /// The recovery of a ring-major cloud whose usable points (`az`, `dist`, `tan`) unfolded into rings
