@@ -236,14 +236,18 @@ def eval_dataset(
     sequences: Optional[Sequence[str]] = None,
     max_frames: Optional[int] = None,
     model: Optional[_Path] = None,
+    layout: Optional[str] = None,
 ) -> dict[str, Any]:
     """Score our methods (default ``nitsch`` and ``learned``) on a labelled SemanticKITTI-layout
-    recording, as ``groundtruth eval --dataset`` does; the dict is its ``--json`` document:
-    ``result["methods"]["learned"]["pooled"]["f1"]``, per frame under ``"frames"``."""
+    recording or a nuScenes-lidarseg folder (``lidar/*.pcd.bin``, ``lidarseg/*_lidarseg.bin``), as
+    ``groundtruth eval --dataset`` does; the dict is its ``--json`` document:
+    ``result["methods"]["learned"]["pooled"]["f1"]``, per frame under ``"frames"``. ``layout``
+    (``"kitti"``, ``"nuscenes"``) names the records of the ``.bin`` files."""
 
-def read(path: _Path, topic: Optional[str] = None) -> Union[Frame, list[Frame]]:
-    """Read a ``.pcd``, ``.ply``, ``.las`` or KITTI ``.bin`` (+ ``.label``) into a Frame; unorganized
-    files give a ``(1, N)`` grid in file order. A ROS 2 bag (``.mcap`` or a rosbag2 directory) gives
+def read(path: _Path, topic: Optional[str] = None, layout: Optional[str] = None) -> Union[Frame, list[Frame]]:
+    """Read a ``.pcd``, ``.ply``, ``.las``, KITTI ``.bin`` (+ ``.label``) or nuScenes ``.pcd.bin`` into
+    a Frame; unorganized files give a ``(1, N)`` grid in file order. ``layout`` (``"kitti"``,
+    ``"nuscenes"``) names the records of a ``.bin`` (default: by name and content). A ROS 2 bag (``.mcap`` or a rosbag2 directory) gives
     a list of Frames, one per PointCloud2 message of ``topic``."""
 
 def write(

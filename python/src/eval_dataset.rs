@@ -33,9 +33,11 @@ fn dataset_error(e: DatasetError) -> PyErr {
 /// class ids). Returns a dict `{"dataset", "protocol", "range_bands", "methods": {name: {"pooled":
 /// {"precision", "recall", "f1", "iou", "accuracy", "tp", "fp", "tn", "fn", "points"},
 /// "frame_mean", "by_range", "worst_frame", "mean_classify_ms", "frames": [...]}}}`, the document of
-/// `groundtruth eval --dataset --json`.
+/// `groundtruth eval --dataset --json`. A folder of nuScenes sweeps with their lidarseg labels
+/// (`lidar/NAME.pcd.bin`, `lidarseg/NAME_lidarseg.bin`) is scored too; `layout` (`"kitti"`,
+/// `"nuscenes"`) names the records of the `.bin` files (default: by name and content).
 #[pyfunction]
-#[pyo3(signature = (path, methods=vec!["nitsch".to_string(), "learned".to_string()], *, rig=None, calibration=None, protocol="semantickitti", ground=None, sensor_height_m=1.73, sequences=None, max_frames=None, model=None))]
+#[pyo3(signature = (path, methods=vec!["nitsch".to_string(), "learned".to_string()], *, rig=None, calibration=None, protocol="semantickitti", ground=None, sensor_height_m=1.73, sequences=None, max_frames=None, model=None, layout=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn eval_dataset<'py>(
     py: Python<'py>,
@@ -49,7 +51,10 @@ pub fn eval_dataset<'py>(
     sequences: Option<Vec<String>>,
     max_frames: Option<usize>,
     model: Option<PathBuf>,
+    layout: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let layout_choice =
+        layout.map(classifier::recording::LayoutChoice::named).transpose().map_err(|e| value_error("layout", e))?;
     if methods.is_empty() {
         return Err(value_error("methods", format!("empty; known: {}", classifier::METHODS.join(", "))));
     }
@@ -87,6 +92,7 @@ pub fn eval_dataset<'py>(
             sequence_setups: sequence_setups.as_ref(),
             protocol: &proto,
             max_frames_per_sequence: max_frames,
+            layout: layout_choice,
         };
         let make = |name: &str| -> classifier::Result<Box<dyn classifier::GroundClassifier + Send>> {
             match resolved.iter().find(|r| r.name() == name) {
@@ -95,7 +101,11 @@ pub fn eval_dataset<'py>(
             }
         };
         let scores = evaluate(&layout, &methods, &make, &options, |_| Ok(()))?;
-        Ok(report(&path, &proto, rig.as_deref(), calibration.as_deref(), &scores))
+        let mut doc = report(&path, &proto, rig.as_deref(), calibration.as_deref(), &scores);
+        if layout.format != classifier::dataset::FrameFormat::SemanticKitti {
+            doc["format"] = serde_json::json!(layout.format);
+        }
+        Ok(doc)
     });
     let doc = doc.map_err(dataset_error)?;
     // Through Python's json module: plain dicts, lists, floats and None.

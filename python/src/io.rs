@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use classifier::recording::{Ordering, Recording, RecordingError, read_as_stored};
+use classifier::recording::{LayoutChoice, Ordering, Recording, RecordingError, read_as_stored_as};
 use groundtruth_scenario::Scan;
 use pyo3::prelude::*;
 use sim::io::formats::Format;
@@ -33,11 +33,23 @@ fn extension(path: &Path) -> String {
 /// each read as the PCD of the same cloud would be. A bag cut short is read up to its last whole
 /// message, with a `UserWarning` naming the last message read.
 ///
-/// Files and bags are read by the library's reader (`classifier::recording`), as stored.
+/// Files and bags are read by the library's reader (`classifier::recording`), as stored. A
+/// nuScenes `.pcd.bin` (x y z intensity ring) gives its rings; a `.bin` whose bytes are nuScenes
+/// records is read as one; `layout` (`"kitti"`, `"nuscenes"`) names the records of a `.bin` file
+/// outright.
 #[pyfunction]
-#[pyo3(signature = (path, topic=None))]
-pub fn read<'py>(py: Python<'py>, path: PathBuf, topic: Option<String>) -> PyResult<Bound<'py, PyAny>> {
+#[pyo3(signature = (path, topic=None, layout=None))]
+pub fn read<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    topic: Option<String>,
+    layout: Option<&str>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let layout = layout.map(LayoutChoice::named).transpose().map_err(|e| value_error("layout", e))?;
     if sim::io::ros2::is_bag(&path) {
+        if layout.is_some() {
+            return Err(value_error("layout", "applies to .bin files, not to a bag"));
+        }
         let frames = read_bag(py, &path, topic)?;
         return Ok(pyo3::types::PyList::new(py, frames)?.into_any());
     }
@@ -47,7 +59,7 @@ pub fn read<'py>(py: Python<'py>, path: PathBuf, topic: Option<String>) -> PyRes
             format!("applies to a bag (.mcap or rosbag2 directory); {} is none", path.display()),
         ));
     }
-    Ok(Bound::new(py, read_file(py, path)?)?.into_any())
+    Ok(Bound::new(py, read_file(py, path, layout)?)?.into_any())
 }
 
 /// The PointCloud2 messages of a bag's topic as Frames.
@@ -92,17 +104,21 @@ fn frame_of(cloud: sim::OrderedCloud, name: &str) -> Frame {
 
 /// Reads one point-cloud file (see [`read`]).
 #[allow(clippy::result_large_err)] // As `read_bag`: one error per call.
-fn read_file(py: Python<'_>, path: PathBuf) -> PyResult<Frame> {
+fn read_file(py: Python<'_>, path: PathBuf, layout: Option<LayoutChoice>) -> PyResult<Frame> {
     if !path.is_file() {
         return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!("path: {}: no such file", path.display())));
     }
     let p = path.clone();
-    let cloud = py.detach(move || read_as_stored(&p)).map_err(|e| match e {
+    let cloud = py.detach(move || read_as_stored_as(&p, layout).map(|(cloud, _)| cloud)).map_err(|e| match e {
         RecordingError::File(e) => sim_error(e),
         RecordingError::Unsupported { .. } => value_error(
             "path",
-            format!("{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label)", path.display()),
+            format!(
+                "{}: unknown extension (readable: .pcd, .ply, .las, .bin with an optional .label, .pcd.bin)",
+                path.display()
+            ),
         ),
+        e @ RecordingError::LayoutOfNonRaw { .. } => value_error("layout", e),
         e => value_error("path", e),
     })?;
     Ok(frame_of(cloud, &path.display().to_string()))

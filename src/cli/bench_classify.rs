@@ -6,7 +6,8 @@
 //! With `--input FILE|DIR` it times the whole path on files instead (`.pcd` and `.bin`, a directory's
 //! files in name order): read, order (unfolding or the beam table of `--rig`, as `classify` does)
 //! and classify, each file `--repeats` times, and prints per file the grid, the ordering path and
-//! its counts, and mean / min milliseconds of `read_ms`, `order_ms`, `classify_ms` and `total_ms`,
+//! its counts, the file's layout and what decided it (`layout`: `kitti-bin`, `nuscenes-bin`, `pcd`,
+//! ...; `layout_by`: `name`, `content` or `flag`), and mean / min milliseconds of `read_ms`, `order_ms`, `classify_ms` and `total_ms`,
 //! plus the same over all files. A driver's organized PCD has its rows put in order as it is
 //! decoded: its `read_ms` is the file's mapping and header, its `order_ms` the decoding in order.
 //! Run it under `taskset -c 0` for one core.
@@ -44,6 +45,10 @@ pub struct Args {
     /// them, or a ROS 2 bag (`.mcap` or rosbag2 directory; `--topic`, or its one PointCloud2 topic).
     #[arg(long)]
     input: Option<std::path::PathBuf>,
+    /// With `--input`: the records of headerless `.bin` files (as `classify --layout`; default: by
+    /// name and content). Each file's layout and what decided it are in the JSON.
+    #[arg(long, value_enum)]
+    layout: Option<super::common::LayoutArg>,
     /// With a bag as `--input`: the PointCloud2 topic.
     #[arg(long)]
     topic: Option<String>,
@@ -139,6 +144,7 @@ fn run_files(args: &Args, recording: &Recording) -> anyhow::Result<()> {
     let mut all_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
     // One reader for every file and repeat, as `classify` reads a sequence: buffers are reused.
     let mut reader = FrameReader::default();
+    reader.set_layout_choice(recording.layout_choice());
     for (index, path) in files.iter().enumerate() {
         let (mut read, mut order, mut cls, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut file_stages: Vec<(&'static str, Vec<f64>)> = Vec::new();
@@ -166,8 +172,11 @@ fn run_files(args: &Args, recording: &Recording) -> anyhow::Result<()> {
         }
         let (ground, points) = last.expect("one repeat");
         let frame = &reader;
+        let (layout, layout_by) = frame.layout();
         let mut entry = serde_json::json!({
             "file": path.display().to_string(),
+            "layout": layout,
+            "layout_by": layout_by,
             "points": points,
             "ground": ground,
             "rows": frame.cloud().rows,
@@ -223,11 +232,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// The benchmark inside the thread pool of `--threads`.
 fn run_in_pool(args: &Args) -> anyhow::Result<()> {
     if let Some(input) = &args.input {
-        let recording = Recording::open(input, args.topic.as_deref())?;
+        let recording = Recording::open(input, args.topic.as_deref())?.with_layout(args.layout.map(Into::into))?;
         if recording.topic().is_some() {
             return run_bag(args, &recording);
         }
         return run_files(args, &recording);
+    }
+    if args.layout.is_some() {
+        anyhow::bail!("--layout applies to files given with --input");
     }
     let frames = super::common::scan_spec(&groundtruth_scenario::ScanSpec {
         scene: args.scene.clone(),

@@ -1,5 +1,5 @@
 //! `groundtruth classify`: classifies the ground points of scanned clouds (a scan directory with
-//! its manifest, a directory of `.pcd` / `.ply` / `.las` / `.bin` files, one file, or a bag: see
+//! its manifest, a directory of `.pcd` / `.ply` / `.las` / `.bin` / `.pcd.bin` files, one file, or a bag: see
 //! [`super::classify_bag`]) and writes one decision file per frame, plus an outcome picture where
 //! the input carries labels. Frames are read by [`classifier::recording`].
 //!
@@ -23,6 +23,11 @@
 //! neither order is refused ([`classifier::ordering::recover`]). Every point gets a cell (a shared cell keeps its second point on a
 //! further plane); only points with NaN or infinite coordinates are skipped (0, counted in the
 //! output; a file with more than 1 % of them is refused). The path taken and the counts are printed.
+//! A nuScenes `.pcd.bin` (x y z intensity ring per point) is ordered from its ring field; a `.bin`
+//! whose bytes are nuScenes records (their length, or a whole ring number as every point's fifth
+//! value) is read as one, and `--layout kitti|nuscenes` names the layout outright; for those, a line
+//! says which layout and why (`by its name`, `by its content`, `by --layout`). NaN points of an
+//! unorganized PCD or PointCloud2 are no-returns (decision 0), not bad points.
 //! Where the input has labels (PCD label field, KITTI `.label` beside the `.bin`), also
 //! `frame_NNNNNN.png`: a bird's-eye view coloured by outcome (true ground, false ground, missed
 //! ground, true non-ground).
@@ -62,6 +67,10 @@ pub struct Args {
     /// model).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// The records of headerless `.bin` files (default: by name, `.pcd.bin` = nuScenes, and by
+    /// content, a `.bin` whose bytes are nuScenes records is read as one; the choice is printed).
+    #[arg(long, value_enum)]
+    layout: Option<super::common::LayoutArg>,
     /// With a bag (`.mcap` or a rosbag2 directory) as `--input`: the PointCloud2 topic to classify
     /// (default: the bag's one PointCloud2 topic; with several, or a wrong one, they are listed).
     #[arg(long)]
@@ -71,7 +80,7 @@ pub struct Args {
 /// Runs `groundtruth classify`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
-    let recording = Recording::open(&args.input, args.topic.as_deref())?;
+    let recording = Recording::open(&args.input, args.topic.as_deref())?.with_layout(args.layout.map(Into::into))?;
     let setup = recording::sensor_setup(args.rig.as_deref(), args.calibration.as_deref())?;
     if recording.topic().is_some() {
         return super::classify_bag::run(&recording, &args.out, &setup, method.as_mut());
@@ -81,6 +90,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     while let Some(frame) = frames.next_frame() {
         let f = frame?;
         let (cloud, report, path) = (f.cloud, f.report, &f.provenance.file);
+        if let Some(line) = super::common::layout_line(f.provenance) {
+            println!("{line}");
+        }
         if let Some(r) = report {
             println!(
                 "{}: ordered into {} x {} x {}: {}",

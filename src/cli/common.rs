@@ -112,3 +112,42 @@ pub fn check_device(caster: &dyn sim::cast::Caster) -> anyhow::Result<()> {
         None => Ok(()),
     }
 }
+
+/// `--layout`: the records of headerless `.bin` files, whatever their names and bytes say
+/// ([`classifier::recording::LayoutChoice`]).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LayoutArg {
+    /// KITTI: float32 x y z intensity (16 bytes per point).
+    Kitti,
+    /// nuScenes: float32 x y z intensity ring (20 bytes per point, a `LIDAR_TOP` `.pcd.bin`).
+    Nuscenes,
+}
+
+impl From<LayoutArg> for classifier::recording::LayoutChoice {
+    fn from(a: LayoutArg) -> Self {
+        match a {
+            LayoutArg::Kitti => Self::Kitti,
+            LayoutArg::Nuscenes => Self::Nuscenes,
+        }
+    }
+}
+
+/// The report line of a file's layout: `FILE: read as LAYOUT, by BASIS` (`name`, `content` or
+/// `flag`) for a nuScenes file and for any layout its name did not decide; `None` for the rest (a
+/// KITTI `.bin`, PCD, PLY, LAS or bag message taken by its name, as before there were layouts to
+/// tell apart).
+pub fn layout_line(provenance: &classifier::recording::Provenance) -> Option<String> {
+    use classifier::recording::{InputLayout, LayoutBasis};
+    let said = provenance.layout == InputLayout::NuscenesBin || provenance.layout_by != LayoutBasis::Name;
+    said.then(|| {
+        let why = match (provenance.layout, provenance.layout_by) {
+            (InputLayout::NuscenesBin, LayoutBasis::Content) => {
+                "by its content (nuScenes' 20-byte records with a whole ring number on every point)"
+            }
+            (_, LayoutBasis::Content) => "by its content",
+            (_, LayoutBasis::Flag) => "by --layout",
+            (_, LayoutBasis::Name) => "by its name",
+        };
+        format!("{}: read as {}, {why}", provenance.file.display(), provenance.layout.description())
+    })
+}

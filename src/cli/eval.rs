@@ -96,8 +96,9 @@ struct ReportArgs {
 /// `groundtruth eval dataset`.
 #[derive(clap::Args, Debug)]
 struct DatasetModeArgs {
-    /// The labelled recording: `DIR/sequences/NN/{velodyne,labels}`, one sequence's folder, or a
-    /// bag (`.mcap` or rosbag2 directory) whose clouds carry a `label` field.
+    /// The labelled recording: `DIR/sequences/NN/{velodyne,labels}`, one sequence's folder, a
+    /// nuScenes-lidarseg folder (`lidar/NAME.pcd.bin` with `lidarseg/NAME_lidarseg.bin`), or a bag
+    /// (`.mcap` or rosbag2 directory) whose clouds carry a `label` field.
     #[arg(long)]
     input: PathBuf,
     /// Comma-separated method names (see `groundtruth list`).
@@ -124,6 +125,10 @@ struct DatasetModeArgs {
     /// With a bag: the PointCloud2 topic.
     #[arg(long)]
     topic: Option<String>,
+    /// The records of the dataset's `.bin` files (default: by name and content: a `.bin` holding
+    /// nuScenes records is read as one, and a line says so).
+    #[arg(long, value_enum)]
+    layout: Option<super::common::LayoutArg>,
     /// Score at most this many frames per sequence.
     #[arg(long)]
     max_frames: Option<usize>,
@@ -236,6 +241,7 @@ impl LegacyArgs {
                 ground: self.ground,
                 sensor_height_m: self.sensor_height,
                 topic: self.topic,
+                layout: None,
                 max_frames: self.max_frames,
                 out: self.out,
                 report: ReportArgs { json: self.json, details: self.details, model: self.model },
@@ -284,6 +290,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             model: a.report.model.as_deref(),
             details: a.report.details,
             topic: a.topic.as_deref(),
+            layout: a.layout.map(Into::into),
         }),
         Mode::Paper(a) => {
             let Paper::Mcdaniel = a.paper;

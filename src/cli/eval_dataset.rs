@@ -1,5 +1,7 @@
 //! `groundtruth eval --dataset DIR`: scores methods on a labelled recording in the SemanticKITTI
-//! layout (real, or written by `groundtruth dataset`), every frame read through the
+//! layout (real, or written by `groundtruth dataset`) or a nuScenes-lidarseg folder
+//! ([`classifier::dataset::layout`]; its JSON says `"format": "nuscenes-lidarseg"`; a frame read
+//! in another layout than its name says is listed under `"layouts"`), every frame read through the
 //! real-recordings path (`--rig`, `--calibration` as `classify` takes them), under a named
 //! protocol ([`classifier::dataset::protocol`]). Prints a table (pooled precision, recall, F1,
 //! IoU, accuracy; the frame mean of F1; the worst frame; F1 by range band; milliseconds per
@@ -11,8 +13,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use classifier::dataset::score::{RANGE_BANDS, band_name};
-use classifier::dataset::{DatasetLayout, EvalOptions, FrameView, MethodScore, Protocol, evaluate, report};
-use classifier::recording::{self, Ordering, Recording};
+use classifier::dataset::{
+    DatasetLayout, EvalOptions, FrameFormat, FrameView, MethodScore, Protocol, evaluate, report,
+};
+use classifier::recording::{self, InputLayout, LayoutBasis, LayoutChoice, Ordering, Provenance, Recording};
 use classifier::registry::{MethodOptions, ResolvedMethod};
 
 /// What `eval --dataset` needs from the command line.
@@ -46,6 +50,8 @@ pub struct DatasetArgs<'a> {
     /// With a bag as the dataset: the PointCloud2 topic (its clouds carry a `label` field; default:
     /// the bag's one PointCloud2 topic).
     pub topic: Option<&'a str>,
+    /// The records of the dataset's `.bin` files (`--layout`).
+    pub layout: Option<classifier::recording::LayoutChoice>,
 }
 
 /// Parses `--ground 40,44,...`.
@@ -91,6 +97,12 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
         bail!("--topic applies to a bag (an .mcap file or a rosbag2 directory); `{}` is none", args.dir.display());
     }
     let layout = DatasetLayout::open(args.dir, args.sequences.as_deref())?;
+    if layout.format == FrameFormat::NuscenesLidarseg && args.layout == Some(LayoutChoice::Kitti) {
+        bail!(
+            "--layout kitti: `{}` is a nuScenes-lidarseg folder, whose `.pcd.bin` sweeps are nuScenes records",
+            args.dir.display()
+        );
+    }
     let setup = recording::sensor_setup(args.rig, args.calibration)?;
     // A dataset of ours, without --rig: each sequence ordered with its own rig and mount.
     let sequence_setups = match (args.rig, args.calibration) {
@@ -122,9 +134,26 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
         sequence_setups: sequence_setups.as_ref(),
         protocol: &protocol,
         max_frames_per_sequence: args.max_frames,
+        layout: args.layout,
     };
+    // Frames whose layout is not a KITTI `.bin` taken by its name: said once each (first method).
+    let mut read_as: Vec<serde_json::Value> = Vec::new();
     let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
     let scores = evaluate(&layout, &args.methods, &make, &options, |view: &FrameView<'_>| {
+        let (frame_layout, basis) = view.layout;
+        let plain = frame_layout == InputLayout::KittiBin && basis == LayoutBasis::Name;
+        if !plain && view.method == args.methods[0] {
+            let provenance = Provenance::file(view.frame.bin.clone(), frame_layout, basis);
+            if let Some(line) = super::common::layout_line(&provenance) {
+                println!("{line}");
+            }
+            read_as.push(serde_json::json!({
+                "sequence": view.frame.sequence,
+                "frame": view.frame.stem,
+                "layout": frame_layout,
+                "layout_by": basis,
+            }));
+        }
         if args.details {
             let c = &view.score.scores.0;
             println!(
@@ -152,7 +181,15 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     })?;
     print_table(&scores);
     if let Some(path) = args.json {
-        let doc = report(args.dir, &protocol, args.rig, args.calibration, &scores);
+        let mut doc = report(args.dir, &protocol, args.rig, args.calibration, &scores);
+        // Said only where a frame was not a KITTI `.bin` taken by its name (the SemanticKITTI
+        // document is as it was).
+        if layout.format != FrameFormat::SemanticKitti {
+            doc["format"] = serde_json::json!(layout.format);
+        }
+        if !read_as.is_empty() {
+            doc["layouts"] = serde_json::json!(read_as);
+        }
         sim::io::atomic::write_bytes_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())?;
         println!("scores written to {}", path.display());
     }
@@ -171,6 +208,9 @@ fn run_bag(
     make: &dyn Fn(&str) -> classifier::Result<Box<dyn classifier::GroundClassifier + Send>>,
 ) -> anyhow::Result<()> {
     use classifier::dataset::FrameScore;
+    if args.layout.is_some() {
+        bail!("--layout applies to .bin files, not to a bag");
+    }
     let recording = Recording::open(args.dir, args.topic)?;
     let topic = recording.topic().unwrap_or_default();
     if args.out.is_some() {

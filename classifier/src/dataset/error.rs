@@ -7,7 +7,7 @@ use std::path::PathBuf;
 pub enum DatasetError {
     /// The directory is not in the SemanticKITTI layout.
     #[error(
-        "`{dir}`: not a SemanticKITTI-layout dataset (expected `sequences/NN/velodyne/*.bin` or `velodyne/*.bin` in it)"
+        "`{dir}`: not a SemanticKITTI-layout dataset (expected `sequences/NN/velodyne/*.bin` or `velodyne/*.bin` in it) nor a nuScenes-lidarseg folder (`lidar/*.pcd.bin` and `lidarseg/*_lidarseg.bin`)"
     )]
     NotADataset {
         /// The directory given.
@@ -28,7 +28,7 @@ pub enum DatasetError {
         label: PathBuf,
     },
     /// A sequence without frames.
-    #[error("`{dir}`: the sequence holds no `.bin` frames")]
+    #[error("`{dir}`: the sequence holds no `.bin` frames (`.pcd.bin` in a nuScenes-lidarseg folder's `lidar/`)")]
     EmptySequence {
         /// The `velodyne/` folder.
         dir: PathBuf,
@@ -83,6 +83,9 @@ pub enum DatasetError {
         /// What is allowed.
         allowed: String,
     },
+    /// A file its reader refused (the error names it and what is wrong).
+    #[error(transparent)]
+    File(#[from] sim::SimError),
     /// Reading a file failed.
     #[error("`{path}`: {source}")]
     Io {

@@ -1,18 +1,19 @@
 //! Scoring methods on a labelled dataset: every frame is read and ordered once, as a user's
-//! recording is ([`SensorSetup::order_kitti`]), every method classifies it, and each decision is
+//! recording is ([`SensorSetup::order_kitti`]; a nuScenes sweep from its rings,
+//! [`SensorSetup::order_flat`]), every method classifies it, and each decision is
 //! scored per input point in the file's own order ([`crate::ordering::decisions_per_point`]),
 //! under a [`Protocol`], by range from the sensor (the file's own coordinates).
 
 use std::time::Instant;
 
-use sim::{OrderedCloud, SemanticClass};
+use sim::OrderedCloud;
 
 use super::DatasetError;
-use super::layout::{DatasetLayout, LabelledFrame};
+use super::layout::{DatasetLayout, FramePoints, LabelledFrame};
 use super::protocol::Protocol;
 use super::score::{FrameScore, MethodScore};
 use crate::methods::{FrameInput, GroundClassifier};
-use crate::ordering::{CloudBuffer, OrderingReport, SensorSetup, decisions_per_point};
+use crate::ordering::{CloudBuffer, OrderingReport, PointAttributes, SensorSetup, decisions_per_point};
 
 /// How to evaluate.
 #[derive(Clone, Debug)]
@@ -26,6 +27,9 @@ pub struct EvalOptions<'a> {
     pub protocol: &'a Protocol,
     /// Score only the first frames of each sequence (`None`: all).
     pub max_frames_per_sequence: Option<usize>,
+    /// The layout of SemanticKITTI-layout `.bin` files (`--layout`; `None`: by name and content,
+    /// [`crate::recording::InputLayout::decide`]).
+    pub layout: Option<crate::recording::LayoutChoice>,
 }
 
 /// One classified frame, handed to the caller (pictures, progress).
@@ -36,6 +40,8 @@ pub struct FrameView<'a> {
     pub cloud: &'a OrderedCloud,
     /// What ordering did.
     pub report: &'a OrderingReport,
+    /// The cloud file's layout and what decided it.
+    pub layout: (crate::recording::InputLayout, crate::recording::LayoutBasis),
     /// The method.
     pub method: &'a str,
     /// Its decisions per cell of `cloud`.
@@ -74,7 +80,7 @@ pub struct FrameView<'a> {
 /// let layout = DatasetLayout::open(dir.path(), None)?;
 /// let setup = SensorSetup::new(Some(&sim::Rig::load("vlp16-roof")?), None)?;
 /// let protocol = Protocol::named("semantickitti", 1.73)?;
-/// let options = EvalOptions { setup: &setup, sequence_setups: None, protocol: &protocol, max_frames_per_sequence: None };
+/// let options = EvalOptions { setup: &setup, sequence_setups: None, protocol: &protocol, max_frames_per_sequence: None, layout: None };
 /// let scores = evaluate(&layout, &["nitsch".to_string()], &|n| classifier::method_by_name(n, 0), &options, |_| Ok(()))?;
 /// assert_eq!(scores[0].pooled().tp + scores[0].pooled().fn_, 8 * 900);
 /// assert!(scores[0].pooled().recall() > 0.95);
@@ -102,9 +108,17 @@ pub fn evaluate(
         let take = options.max_frames_per_sequence.unwrap_or(usize::MAX);
         let setup = options.sequence_setups.and_then(|m| m.get(&sequence.id)).unwrap_or(options.setup);
         for (index, frame) in sequence.frames.iter().take(take).enumerate() {
-            let (records, raw_labels) = frame.read()?;
-            let classes: Vec<SemanticClass> = raw_labels.iter().map(|&l| SemanticClass((l & 0xFFFF) as u16)).collect();
-            setup.order_kitti(&records, Some(&classes), &mut buffer, &mut report).map_err(classify_error(frame))?;
+            let FramePoints { records, rings, classes, layout } = frame.read_points(options.layout)?;
+            match &rings {
+                // A nuScenes sweep: ordered from its rings, as `classify` orders it.
+                Some(rings) => {
+                    let attributes =
+                        PointAttributes { intensity: None, labels: Some(&classes), time_s: None, rings: Some(rings) };
+                    setup.order_flat(&records, &attributes, &mut buffer, &mut report)
+                }
+                None => setup.order_kitti(&records, Some(&classes), &mut buffer, &mut report),
+            }
+            .map_err(classify_error(frame))?;
             let cloud = buffer.cloud();
             for (method, score) in built.iter_mut().zip(scores.iter_mut()) {
                 let t = Instant::now();
@@ -131,6 +145,7 @@ pub fn evaluate(
                     frame,
                     cloud,
                     report: &report,
+                    layout,
                     method: &score.method,
                     ground: &ground,
                     score: &fs,

@@ -1,14 +1,51 @@
-//! Which sequences and frames a SemanticKITTI-layout directory holds, and reading one frame.
+//! Which sequences and frames a labelled dataset directory holds, and reading one frame.
 //!
-//! A dataset root holds `sequences/NN/velodyne/NNNNNN.bin` with `sequences/NN/labels/NNNNNN.label`
+//! Two layouts ([`FrameFormat`]):
+//!
+//! - **SemanticKITTI**: a dataset root holds `sequences/NN/velodyne/NNNNNN.bin` with `sequences/NN/labels/NNNNNN.label`
 //! beside them (SemanticKITTI's, KITTI-360 and others converted to it, and `groundtruth dataset`'s
 //! output); a single sequence's folder holding `velodyne/` and `labels/` is taken too. Frames are
 //! sorted by file name. `.bin`: float32 `x y z intensity` records (sensor frame); `.label`: one
 //! uint32 per point, the class id in the lower 16 bits (the instance in the upper).
+//! - **nuScenes-lidarseg**: a folder holding `lidar/NAME.pcd.bin` (nuScenes sweeps: float32 `x y z
+//!   intensity ring`) with `lidarseg/NAME_lidarseg.bin` beside them (one uint8 class id per point):
+//!   nuScenes keeps the sweeps as `samples/LIDAR_TOP/<name>.pcd.bin` and the labels as
+//!   `lidarseg/<version>/<sample_data token>_lidarseg.bin`, so the folder is made by linking each
+//!   sweep under its sample_data token (`docs/real-recordings.md`). The folder is one sequence (its
+//!   name the id); the class ids become SemanticKITTI's
+//!   ([`sim::io::nuscenes::lidarseg_to_semantic_kitti`]: ground 24-27 as road, other-ground,
+//!   sidewalk, terrain; noise and the ego vehicle left out), so every protocol scores them.
 
 use std::path::{Path, PathBuf};
 
+use sim::SemanticClass;
+
 use super::DatasetError;
+use crate::recording::{InputLayout, LayoutBasis, LayoutChoice, RecordingError};
+
+/// The layout of a labelled dataset's frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FrameFormat {
+    /// KITTI `.bin` records with SemanticKITTI `.label` files.
+    SemanticKitti,
+    /// nuScenes `.pcd.bin` sweeps with lidarseg `_lidarseg.bin` files.
+    NuscenesLidarseg,
+}
+
+/// A frame's points in file order, as [`LabelledFrame::read_points`] reads them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FramePoints {
+    /// `x y z intensity` per point (sensor frame).
+    pub records: Vec<[f32; 4]>,
+    /// The ring (laser) per point, where the format has one (nuScenes).
+    pub rings: Option<Vec<u16>>,
+    /// The class per point (SemanticKITTI ids).
+    pub classes: Vec<SemanticClass>,
+    /// The cloud file's layout and what decided it (a `velodyne/*.bin` holding nuScenes records is
+    /// read as one: [`InputLayout::decide`]).
+    pub layout: (InputLayout, LayoutBasis),
+}
 
 /// One labelled frame.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -21,6 +58,8 @@ pub struct LabelledFrame {
     pub bin: PathBuf,
     /// Its labels.
     pub label: PathBuf,
+    /// The layout of the two files.
+    pub format: FrameFormat,
 }
 
 /// One sequence and its frames.
@@ -41,6 +80,8 @@ pub struct DatasetLayout {
     pub root: PathBuf,
     /// Its sequences in folder-name order.
     pub sequences: Vec<Sequence>,
+    /// The layout of its frames.
+    pub format: FrameFormat,
 }
 
 impl DatasetLayout {
@@ -62,6 +103,9 @@ impl DatasetLayout {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn open(dir: &Path, only: Option<&[String]>) -> Result<Self, DatasetError> {
+        if dir.join("lidar").is_dir() && dir.join("lidarseg").is_dir() {
+            return Self::open_lidarseg(dir, only);
+        }
         let io = |path: &Path| {
             let path = path.to_path_buf();
             move |source| DatasetError::Io { path, source }
@@ -121,11 +165,62 @@ impl DatasetLayout {
                 if !label.is_file() {
                     return Err(DatasetError::MissingLabel { bin, label });
                 }
-                frames.push(LabelledFrame { sequence: id.clone(), stem, bin, label });
+                frames.push(LabelledFrame {
+                    sequence: id.clone(),
+                    stem,
+                    bin,
+                    label,
+                    format: FrameFormat::SemanticKitti,
+                });
             }
             sequences.push(Sequence { id, dir: seq, frames });
         }
-        Ok(Self { root: dir.to_path_buf(), sequences })
+        Ok(Self { root: dir.to_path_buf(), sequences, format: FrameFormat::SemanticKitti })
+    }
+
+    /// A nuScenes-lidarseg folder (module docs): `lidar/NAME.pcd.bin` with
+    /// `lidarseg/NAME_lidarseg.bin`, one sequence named after the folder. Refused: a sweep without
+    /// its labels, no sweeps, `only` naming another sequence.
+    fn open_lidarseg(dir: &Path, only: Option<&[String]>) -> Result<Self, DatasetError> {
+        let id = dir
+            .canonicalize()
+            .ok()
+            .and_then(|d| d.file_name().and_then(|n| n.to_str()).map(str::to_string))
+            .unwrap_or_else(|| "nuscenes".to_string());
+        if let Some(only) = only
+            && let Some(other) = only.iter().find(|s| **s != id)
+        {
+            return Err(DatasetError::UnknownSequence { id: other.clone(), dir: dir.to_path_buf(), known: id });
+        }
+        let (lidar, lidarseg) = (dir.join("lidar"), dir.join("lidarseg"));
+        let mut bins: Vec<(String, PathBuf)> = Vec::new();
+        for entry in std::fs::read_dir(&lidar).map_err(|source| DatasetError::Io { path: lidar.clone(), source })? {
+            let path = entry.map_err(|source| DatasetError::Io { path: lidar.clone(), source })?.path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+            if let Some(stem) = name.strip_suffix(".pcd.bin") {
+                bins.push((stem.to_string(), path.clone()));
+            }
+        }
+        bins.sort();
+        if bins.is_empty() {
+            return Err(DatasetError::EmptySequence { dir: lidar });
+        }
+        let mut frames = Vec::with_capacity(bins.len());
+        for (stem, bin) in bins {
+            let label = lidarseg.join(format!("{stem}_lidarseg.bin"));
+            if !label.is_file() {
+                return Err(DatasetError::MissingLabel { bin, label });
+            }
+            frames.push(LabelledFrame {
+                sequence: id.clone(),
+                stem,
+                bin,
+                label,
+                format: FrameFormat::NuscenesLidarseg,
+            });
+        }
+        let sequences = vec![Sequence { id, dir: dir.to_path_buf(), frames }];
+        Ok(Self { root: dir.to_path_buf(), sequences, format: FrameFormat::NuscenesLidarseg })
     }
 
     /// Every frame, sequence by sequence.
@@ -135,16 +230,48 @@ impl DatasetLayout {
 }
 
 impl LabelledFrame {
-    /// Reads the frame: its records (float32 `x y z intensity`) and its raw uint32 labels, checked
-    /// against each other (a truncated `.bin`, a `.label` of another length are refused).
-    pub fn read(&self) -> Result<(Vec<[f32; 4]>, Vec<u32>), DatasetError> {
-        let bin = std::fs::read(&self.bin).map_err(|source| DatasetError::Io { path: self.bin.clone(), source })?;
-        if bin.len() % 16 != 0 {
-            return Err(DatasetError::Truncated { path: self.bin.clone(), bytes: bin.len() as u64 });
+    /// Reads the frame's points in file order with their classes (SemanticKITTI ids) and, for a
+    /// nuScenes sweep, their rings; checked as [`LabelledFrame::read`] checks a SemanticKITTI frame,
+    /// a nuScenes sweep as [`sim::io::nuscenes`] reads it (20-byte records, whole rings, one label
+    /// byte per point, class ids of the lidarseg taxonomy).
+    ///
+    /// A SemanticKITTI frame's `.bin` is read in the layout `choice` names (`--layout`), else in
+    /// the one its bytes give away ([`InputLayout::decide`]: nuScenes records renamed `.bin` are
+    /// read as nuScenes, with their rings), else as KITTI records.
+    pub fn read_points(&self, choice: Option<LayoutChoice>) -> Result<FramePoints, DatasetError> {
+        if self.format == FrameFormat::NuscenesLidarseg {
+            let p = sim::io::nuscenes::read_points(&self.bin)?;
+            let classes = sim::io::nuscenes::read_lidarseg(&self.label, &self.bin, p.points.len())?;
+            let records = p.points.iter().zip(&p.intensity).map(|(q, &i)| [q.x, q.y, q.z, i]).collect();
+            let layout = (InputLayout::NuscenesBin, LayoutBasis::Name);
+            return Ok(FramePoints { records, rings: Some(p.rings), classes, layout });
         }
+        let bin = std::fs::read(&self.bin).map_err(|source| DatasetError::Io { path: self.bin.clone(), source })?;
+        let layout = InputLayout::decide(&self.bin, &bin, choice).map_err(|e| match e {
+            RecordingError::File(e) => DatasetError::File(e),
+            e => DatasetError::Invalid {
+                flag: "--layout",
+                value: self.bin.display().to_string(),
+                allowed: e.to_string(),
+            },
+        })?;
+        let (records, rings, raw_labels) = if layout.0 == InputLayout::NuscenesBin {
+            let mut p = sim::io::nuscenes::NuscenesPoints::default();
+            sim::io::nuscenes::points_from_bytes_into(&self.bin, &bin, &mut p)?;
+            let records = p.points.iter().zip(&p.intensity).map(|(q, &i)| [q.x, q.y, q.z, i]).collect();
+            (records, Some(p.rings), self.read_labels(p.points.len())?)
+        } else {
+            let (records, labels) = self.kitti_from_bytes(&bin)?;
+            (records, None, labels)
+        };
+        let classes = raw_labels.iter().map(|&l| SemanticClass((l & 0xFFFF) as u16)).collect();
+        Ok(FramePoints { records, rings, classes, layout })
+    }
+
+    /// The `.label`'s raw uint32 labels, checked against the cloud's `points`.
+    fn read_labels(&self, points: usize) -> Result<Vec<u32>, DatasetError> {
         let label =
             std::fs::read(&self.label).map_err(|source| DatasetError::Io { path: self.label.clone(), source })?;
-        let points = bin.len() / 16;
         if label.len() % 4 != 0 || label.len() / 4 != points {
             return Err(DatasetError::LabelCount {
                 label: self.label.clone(),
@@ -153,6 +280,28 @@ impl LabelledFrame {
                 points,
             });
         }
+        Ok(label.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
+    }
+
+    /// Reads the frame: its records (float32 `x y z intensity`) and its raw uint32 labels, checked
+    /// against each other (a truncated `.bin`, a `.label` of another length are refused).
+    /// A nuScenes sweep gives its `x y z intensity` and its classes as SemanticKITTI ids.
+    pub fn read(&self) -> Result<(Vec<[f32; 4]>, Vec<u32>), DatasetError> {
+        if self.format == FrameFormat::NuscenesLidarseg {
+            let p = self.read_points(None)?;
+            return Ok((p.records, p.classes.iter().map(|c| u32::from(c.0)).collect()));
+        }
+        let bin = std::fs::read(&self.bin).map_err(|source| DatasetError::Io { path: self.bin.clone(), source })?;
+        self.kitti_from_bytes(&bin)
+    }
+
+    /// The KITTI records of the `.bin`'s bytes `bin` and the `.label`'s raw labels, checked
+    /// against each other.
+    fn kitti_from_bytes(&self, bin: &[u8]) -> Result<(Vec<[f32; 4]>, Vec<u32>), DatasetError> {
+        if bin.len() % 16 != 0 {
+            return Err(DatasetError::Truncated { path: self.bin.clone(), bytes: bin.len() as u64 });
+        }
+        let labels = self.read_labels(bin.len() / 16)?;
         let records = bin
             .chunks_exact(16)
             .map(|c| {
@@ -160,7 +309,6 @@ impl LabelledFrame {
                 [f(0), f(1), f(2), f(3)]
             })
             .collect();
-        let labels = label.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
         Ok((records, labels))
     }
 }

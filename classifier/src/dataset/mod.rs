@@ -1,4 +1,5 @@
-//! Labelled recordings in the SemanticKITTI layout, real or ours, and the scores of ground
+//! Labelled recordings in the SemanticKITTI layout, real or ours, or nuScenes sweeps with their
+//! lidarseg labels, and the scores of ground
 //! classification methods on them under a named protocol.
 //!
 //! - [`layout`]: which sequences and frames a directory holds (`DIR/sequences/NN/{velodyne,labels}`
@@ -22,6 +23,6 @@ pub mod score;
 
 pub use error::DatasetError;
 pub use evaluate::{EvalOptions, FrameView, evaluate, report};
-pub use layout::{DatasetLayout, LabelledFrame, Sequence};
+pub use layout::{DatasetLayout, FrameFormat, FramePoints, LabelledFrame, Sequence};
 pub use protocol::Protocol;
 pub use score::{FrameScore, MethodScore, RANGE_BAND_EDGES_M};

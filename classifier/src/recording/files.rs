@@ -7,6 +7,12 @@
 //!   `ring` field.
 //! - KITTI `.bin` (and its `.label`): ordered where the file's bytes lie, by scan unfolding or the
 //!   beam table ([`SensorSetup::order_kitti`]).
+//! - nuScenes `.pcd.bin` (or a `.bin` whose bytes give the layout away, or `--layout nuscenes`:
+//!   [`InputLayout::decide`]): ordered from its ring field, as a PCD's `ring` is.
+//! - No-returns: an unorganized PCD or PointCloud2 holds them as NaN points (PCL's convention; a
+//!   message declaring `is_dense = false`, or one declaring `is_dense = true` that holds NaNs
+//!   anyway, which is counted for a warning): they are read as no-returns (decision 0, kept in
+//!   place), not as bad data. A KITTI file's NaNs stay bad data.
 //! - PLY, LAS: ordered from their points as an unorganized cloud is (their `ring` where they have
 //!   one).
 //! - A bag's PointCloud2 message: decoded by the PCD reader straight from the message's data
@@ -21,7 +27,7 @@ use sim::io::pcd::PcdFrame;
 use sim::io::ros2::BagCloud;
 
 use super::bytes::InputBytes;
-use super::{InputLayout, Provenance, RecordingError};
+use super::{InputLayout, LayoutBasis, LayoutChoice, Provenance, RecordingError};
 use crate::ordering::{CloudBuffer, OrderingReport, PointAttributes, SensorSetup, read_organized_into};
 
 /// Reads and orders frames one after another, keeping its buffers (the file's bytes, its points,
@@ -36,6 +42,16 @@ pub struct FrameReader {
     label_bytes: InputBytes,
     /// A KITTI file's records.
     flat: sim::io::kitti::KittiPoints,
+    /// A nuScenes file's points and rings.
+    nuscenes: sim::io::nuscenes::NuscenesPoints,
+    /// The layout `--layout` names for `.bin` files.
+    choice: Option<LayoutChoice>,
+    /// The last file's layout and what decided it.
+    decided: Option<(InputLayout, LayoutBasis)>,
+    /// NaN points of the last unorganized PCD or message, read as no-returns.
+    nan_no_returns: usize,
+    /// Whether the last message declared `is_dense = true`.
+    declared_dense: bool,
     /// A PCD as the file holds it (ordered from here where it is not organized).
     file_cloud: OrderedCloud,
     /// The cloud to classify.
@@ -58,6 +74,26 @@ impl FrameReader {
         self.ordered.then_some(&self.report)
     }
 
+    /// Reads headerless `.bin` files in `choice` (`--layout`) rather than by name and content.
+    pub fn set_layout_choice(&mut self, choice: Option<LayoutChoice>) {
+        self.choice = choice;
+    }
+
+    /// The last file's layout and what decided it (a bag's message: PointCloud2, by name).
+    pub fn layout(&self) -> (InputLayout, LayoutBasis) {
+        self.decided.unwrap_or((InputLayout::PointCloud2, LayoutBasis::Name))
+    }
+
+    /// NaN points of the last unorganized PCD or message, read as no-returns (0 for other layouts).
+    pub fn nan_no_returns(&self) -> usize {
+        self.nan_no_returns
+    }
+
+    /// Whether the last message declared itself dense (`is_dense = true`; false for files).
+    pub fn declared_dense(&self) -> bool {
+        self.declared_dense
+    }
+
     /// Takes `cloud` as the last frame's, unordered (a frame read as stored).
     pub(crate) fn set_cloud(&mut self, cloud: OrderedCloud) {
         *self.cloud.cloud_mut() = cloud;
@@ -69,41 +105,23 @@ impl FrameReader {
     pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> Result<f64, RecordingError> {
         let t0 = Instant::now();
         self.ordered = false;
-        let ordering = |error| RecordingError::Ordering { what: format!("`{}`", path.display()), error };
-        match InputLayout::of_file(path)? {
+        self.nan_no_returns = 0;
+        self.declared_dense = false;
+        self.decided = None;
+        let by_name = InputLayout::of_file(path)?;
+        if by_name.is_raw() {
+            return self.read_raw(path, setup, t0);
+        }
+        self.decided = Some(InputLayout::decide(path, &[], self.choice)?);
+        match by_name {
             InputLayout::Pcd => {
-                let FrameReader { bytes, file_cloud, cloud, report, ordered, .. } = self;
+                let FrameReader { bytes, file_cloud, cloud, report, ordered, nan_no_returns, .. } = self;
                 let bytes = bytes.load(path)?;
                 let frame = PcdFrame::parse(path, bytes)?;
-                let (read_ms, from_another_tool) = order_pcd(path, &frame, setup, file_cloud, cloud, report, t0)?;
-                *ordered = from_another_tool;
-                Ok(read_ms)
-            }
-            InputLayout::KittiBin => {
-                let label = path.with_extension("label");
-                let bytes = self.bytes.load(path)?;
-                let label_bytes = match label.is_file() {
-                    true => Some((label.as_path(), self.label_bytes.load(&label)?)),
-                    false => None,
-                };
-                // The records are ordered where the file's bytes lie (no decoding copy) where
-                // they can be; the points are decoded otherwise.
-                let records = sim::io::kitti::records_or_points_into(path, bytes, label_bytes, &mut self.flat)?;
-                let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-                let flat = &self.flat;
-                let labels = flat.labels.as_deref();
-                let ordered = match records {
-                    // Scan-ordered, shuffled or organized (an Ouster image with zero no-returns).
-                    Some(records) => setup.order_kitti(records, labels, &mut self.cloud, &mut self.report),
-                    None => {
-                        let records: Vec<[f32; 4]> =
-                            flat.points.iter().zip(&flat.intensity).map(|(p, &i)| [p.x, p.y, p.z, i]).collect();
-                        setup.order_kitti(&records, labels, &mut self.cloud, &mut self.report)
-                    }
-                };
-                ordered.map_err(ordering)?;
-                self.ordered = true;
-                Ok(read_ms)
+                let read = order_pcd(path, &frame, setup, file_cloud, cloud, report, t0)?;
+                *ordered = read.from_another_tool;
+                *nan_no_returns = read.nan_no_returns;
+                Ok(read.read_ms)
             }
             layout @ (InputLayout::Ply | InputLayout::Las) => {
                 let (c, has_ring) = match layout {
@@ -115,8 +133,53 @@ impl FrameReader {
                 self.ordered = true;
                 Ok(read_ms)
             }
-            InputLayout::PointCloud2 => Err(RecordingError::Unsupported { path: path.to_path_buf() }),
+            _ => Err(RecordingError::Unsupported { path: path.to_path_buf() }),
         }
+    }
+
+    /// Reads a headerless `.bin` (`t0`: when the read began) in the layout its name, its bytes or
+    /// `--layout` give ([`InputLayout::decide`]) and orders it: KITTI records where its bytes lie
+    /// ([`SensorSetup::order_kitti`]), nuScenes points from their rings.
+    fn read_raw(&mut self, path: &Path, setup: &SensorSetup, t0: Instant) -> Result<f64, RecordingError> {
+        let ordering = |error| RecordingError::Ordering { what: format!("`{}`", path.display()), error };
+        let FrameReader { bytes, label_bytes, flat, nuscenes, cloud, report, choice, decided, ordered, .. } = self;
+        let bytes = bytes.load(path)?;
+        let (layout, basis) = InputLayout::decide(path, bytes, *choice)?;
+        *decided = Some((layout, basis));
+        if layout == InputLayout::NuscenesBin {
+            sim::io::nuscenes::points_from_bytes_into(path, bytes, nuscenes)?;
+            let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+            let attributes = PointAttributes {
+                intensity: Some(&nuscenes.intensity),
+                rings: Some(&nuscenes.rings),
+                ..PointAttributes::default()
+            };
+            setup.order_flat(&nuscenes.points, &attributes, cloud, report).map_err(ordering)?;
+            *ordered = true;
+            return Ok(read_ms);
+        }
+        let label = path.with_extension("label");
+        let label_bytes = match label.is_file() {
+            true => Some((label.as_path(), label_bytes.load(&label)?)),
+            false => None,
+        };
+        // The records are ordered where the file's bytes lie (no decoding copy) where they can be;
+        // the points are decoded otherwise.
+        let records = sim::io::kitti::records_or_points_into(path, bytes, label_bytes, flat)?;
+        let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let labels = flat.labels.as_deref();
+        let result = match records {
+            // Scan-ordered, shuffled or organized (an Ouster image with zero no-returns).
+            Some(records) => setup.order_kitti(records, labels, cloud, report),
+            None => {
+                let records: Vec<[f32; 4]> =
+                    flat.points.iter().zip(&flat.intensity).map(|(p, &i)| [p.x, p.y, p.z, i]).collect();
+                setup.order_kitti(&records, labels, cloud, report)
+            }
+        };
+        result.map_err(ordering)?;
+        *ordered = true;
+        Ok(read_ms)
     }
 
     /// Reads a bag's PointCloud2 message (`provenance` names it in errors) straight from its data
@@ -132,6 +195,8 @@ impl FrameReader {
     ) -> Result<f64, RecordingError> {
         let t0 = Instant::now();
         self.ordered = false;
+        self.nan_no_returns = 0;
+        self.decided = None;
         let bad = |reason: String| RecordingError::Message {
             bag: provenance.file.clone(),
             topic: provenance.topic.clone().unwrap_or_default(),
@@ -141,6 +206,7 @@ impl FrameReader {
         let name = provenance.name();
         let name = name.as_path();
         let cloud = message.decode().map_err(bad)?;
+        self.declared_dense = cloud.is_dense;
         let frame =
             sim::io::ros2::pointcloud2::frame(name, &cloud, message.groundtruth_comment.as_deref()).map_err(bad)?;
         let Some(setup) = setup else {
@@ -148,27 +214,52 @@ impl FrameReader {
             return Ok(t0.elapsed().as_secs_f64() * 1e3);
         };
         let FrameReader { file_cloud, cloud, report, .. } = self;
-        let (read_ms, ordered) =
-            order_pcd(name, &frame, setup, file_cloud, cloud, report, t0).map_err(|e| bad(e.to_string()))?;
-        self.ordered = ordered;
-        Ok(read_ms)
+        let read = order_pcd(name, &frame, setup, file_cloud, cloud, report, t0).map_err(|e| bad(e.to_string()))?;
+        self.ordered = read.from_another_tool;
+        self.nan_no_returns = read.nan_no_returns;
+        Ok(read.read_ms)
     }
 }
 
 /// Reads `path` as the file holds it, unordered: an organized PCD keeps its grid (`HEIGHT x WIDTH`,
 /// its rows in the file's order), every other file is a `1 x N` grid in file order (a KITTI `.bin`
-/// with its `.label` where there is one).
+/// with its `.label` where there is one, a nuScenes file with its rings).
 pub fn read_as_stored(path: &Path) -> Result<OrderedCloud, RecordingError> {
-    Ok(match InputLayout::of_file(path)? {
+    read_as_stored_as(path, None).map(|(cloud, _)| cloud)
+}
+
+/// As [`read_as_stored`], a headerless `.bin` read in `choice` (`--layout`, `layout=`) where
+/// given, else in the layout its name and bytes give ([`InputLayout::decide`]); also returns the
+/// layout and what decided it.
+pub fn read_as_stored_as(
+    path: &Path,
+    choice: Option<LayoutChoice>,
+) -> Result<(OrderedCloud, (InputLayout, LayoutBasis)), RecordingError> {
+    let by_name = InputLayout::of_file(path)?;
+    if by_name.is_raw() {
+        let bytes = std::fs::read(path).map_err(|e| sim::SimError::io(path, e))?;
+        let decided = InputLayout::decide(path, &bytes, choice)?;
+        let cloud = match decided.0 {
+            InputLayout::NuscenesBin => sim::io::nuscenes::cloud_from_bytes(path, &bytes)?,
+            _ => {
+                let label = path.with_extension("label");
+                let label_bytes = match label.is_file() {
+                    true => Some(std::fs::read(&label).map_err(|e| sim::SimError::io(&label, e))?),
+                    false => None,
+                };
+                sim::io::kitti::read_bytes(path, &bytes, label_bytes.as_deref().map(|b| (label.as_path(), b)))?
+            }
+        };
+        return Ok((cloud, decided));
+    }
+    let decided = InputLayout::decide(path, &[], choice)?;
+    let cloud = match by_name {
         InputLayout::Pcd => sim::io::pcd::read(path)?,
         InputLayout::Ply => sim::io::ply::read(path)?,
         InputLayout::Las => sim::io::las::read(path)?,
-        InputLayout::KittiBin => {
-            let label = path.with_extension("label");
-            sim::io::kitti::read(path, label.is_file().then_some(label.as_path()))?
-        }
-        InputLayout::PointCloud2 => return Err(RecordingError::Unsupported { path: path.to_path_buf() }),
-    })
+        _ => return Err(RecordingError::Unsupported { path: path.to_path_buf() }),
+    };
+    Ok((cloud, decided))
 }
 
 /// Orders an unorganized cloud `c` read from `path` (its points, intensity, labels, times, and its
@@ -189,11 +280,19 @@ fn order_flat_cloud(
         .map_err(|error| RecordingError::Ordering { what: format!("`{}`", path.display()), error })
 }
 
+/// What [`order_pcd`] did: the milliseconds of the read, whether the cloud came from another tool
+/// (then the report holds what ordering did), and the NaN points of an unorganized cloud read as
+/// no-returns.
+struct PcdRead {
+    read_ms: f64,
+    from_another_tool: bool,
+    nan_no_returns: usize,
+}
+
 /// Orders a parsed PCD `frame` into `cloud`: a driver's organized cloud has its rows put in order
 /// as it is decoded; our own layout (or several echo planes) is taken as it is; an unorganized
-/// cloud is ordered as a KITTI file is, or from its `ring` field. Returns the milliseconds of the
-/// read (since `t0`) and whether the cloud came from another tool (then `report` holds what
-/// ordering did).
+/// cloud is ordered as a KITTI file is, or from its `ring` field, its NaN points read as
+/// no-returns (`0, 0, 0`: decision 0, kept in place), as PCL and the drivers write them.
 #[allow(clippy::too_many_arguments)]
 fn order_pcd(
     path: &Path,
@@ -203,7 +302,7 @@ fn order_pcd(
     cloud: &mut CloudBuffer,
     report: &mut OrderingReport,
     t0: Instant,
-) -> Result<(f64, bool), RecordingError> {
+) -> Result<PcdRead, RecordingError> {
     let (info, (rows, _, planes)) = (frame.info(), frame.shape());
     if info.organized && !info.ours && planes == 1 {
         // A driver's organized cloud: its rows are put in order as it is decoded, so `read_ms` is
@@ -216,15 +315,29 @@ fn order_pcd(
         }
         read_organized_into(frame, setup.vehicle_from_sensor, cloud.cloud_mut(), report)
             .map_err(|error| RecordingError::Ordering { what: format!("the rows of `{}`", path.display()), error })?;
-        return Ok((read_ms, true));
+        return Ok(PcdRead { read_ms, from_another_tool: true, nan_no_returns: 0 });
     }
     let info = frame.read_into(file_cloud, None, Affine3A::IDENTITY)?;
     let read_ms = t0.elapsed().as_secs_f64() * 1e3;
     if info.ours || file_cloud.planes > 1 {
         std::mem::swap(cloud.cloud_mut(), file_cloud);
-        return Ok((read_ms, false));
+        return Ok(PcdRead { read_ms, from_another_tool: false, nan_no_returns: 0 });
     }
-    // An unorganized PCD: ordered as a KITTI file is.
+    // An unorganized PCD: its NaN points are no-returns; ordered as a KITTI file is.
+    let nan_no_returns = nan_points_to_no_returns(file_cloud);
     order_flat_cloud(path, file_cloud, info.has_ring, setup, cloud, report)?;
-    Ok((read_ms, true))
+    Ok(PcdRead { read_ms, from_another_tool: true, nan_no_returns })
+}
+
+/// Puts every point of `cloud` with a NaN or infinite coordinate at `0, 0, 0` (a no-return, which
+/// ordering skips and counts as such); returns how many there were.
+fn nan_points_to_no_returns(cloud: &mut OrderedCloud) -> usize {
+    let mut count = 0;
+    for p in &mut cloud.point_in_vehicle {
+        if !p.is_finite() {
+            *p = glam::Vec3::ZERO;
+            count += 1;
+        }
+    }
+    count
 }

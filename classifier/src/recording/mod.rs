@@ -44,8 +44,8 @@ use sim::io::ros2::{Bag, BagCloud, BagClouds};
 
 pub use bag::resolve_topic;
 pub use bytes::InputBytes;
-pub use files::{FrameReader, read_as_stored};
-pub use input::{InputFile, InputLayout, list_files};
+pub use files::{FrameReader, read_as_stored, read_as_stored_as};
+pub use input::{InputFile, InputLayout, LayoutBasis, LayoutChoice, list_files};
 pub use provenance::Provenance;
 
 use crate::error::ClassifyError;
@@ -82,6 +82,27 @@ pub enum RecordingError {
     Unsupported {
         /// The file.
         path: PathBuf,
+    },
+    /// A `--layout` of no known name.
+    #[error("--layout `{name}`: allowed {}", LayoutChoice::NAMES.join(", "))]
+    UnknownLayout {
+        /// The name given.
+        name: String,
+    },
+    /// A `--layout` for a file that is not a headerless `.bin`.
+    #[error(
+        "`{}`: --layout {} applies to headerless .bin files (KITTI or nuScenes records); this is a {} file",
+        .path.display(),
+        .choice.name(),
+        .named.description()
+    )]
+    LayoutOfNonRaw {
+        /// The file.
+        path: PathBuf,
+        /// The layout asked for.
+        choice: LayoutChoice,
+        /// The file's layout by its name.
+        named: InputLayout,
     },
     /// A rig that could not be loaded.
     #[error("loading rig `{name}`: {error}")]
@@ -192,6 +213,7 @@ pub enum Ordering<'a> {
 pub struct Recording {
     path: PathBuf,
     source: Source,
+    layout: Option<LayoutChoice>,
 }
 
 #[derive(Debug)]
@@ -208,12 +230,33 @@ impl Recording {
         if sim::io::ros2::is_bag(path) {
             let bag = Bag::open(path)?;
             let topic = resolve_topic(&bag, topic)?;
-            return Ok(Self { path: path.to_path_buf(), source: Source::Bag { bag, topic } });
+            return Ok(Self { path: path.to_path_buf(), source: Source::Bag { bag, topic }, layout: None });
         }
         if topic.is_some() {
             return Err(RecordingError::TopicWithoutBag { path: path.to_path_buf() });
         }
-        Ok(Self { path: path.to_path_buf(), source: Source::Files(list_files(path)?) })
+        Ok(Self { path: path.to_path_buf(), source: Source::Files(list_files(path)?), layout: None })
+    }
+
+    /// The same recording with its headerless `.bin` files read in `layout` (`--layout`: KITTI or
+    /// nuScenes records, whatever their names and contents say); `None` decides per file
+    /// ([`InputLayout::decide`]). Refused: a layout for a bag, a layout for a file that is not a
+    /// `.bin` (when its frame is read).
+    pub fn with_layout(mut self, layout: Option<LayoutChoice>) -> Result<Self, RecordingError> {
+        if let (Some(choice), Source::Bag { .. }) = (layout, &self.source) {
+            return Err(RecordingError::LayoutOfNonRaw {
+                path: self.path.clone(),
+                choice,
+                named: InputLayout::PointCloud2,
+            });
+        }
+        self.layout = layout;
+        Ok(self)
+    }
+
+    /// The layout `--layout` named for its `.bin` files, if any.
+    pub fn layout_choice(&self) -> Option<LayoutChoice> {
+        self.layout
     }
 
     /// The path given.
@@ -243,17 +286,20 @@ impl Recording {
             Source::Bag { bag, topic } => Some(bag.clouds(topic)?),
             Source::Files(_) => None,
         };
+        let mut reader = FrameReader::default();
+        reader.set_layout_choice(self.layout);
         Ok(Frames {
             recording: self,
             ordering,
-            reader: FrameReader::default(),
+            reader,
             next_file: 0,
             clouds,
             message: None,
-            provenance: Provenance::file(self.path.clone(), InputLayout::PointCloud2),
+            provenance: Provenance::file(self.path.clone(), InputLayout::PointCloud2, LayoutBasis::Name),
             world_from_vehicle: None,
             warnings: Vec::new(),
             cuts_seen: 0,
+            dense_with_nan: None,
         })
     }
 }
@@ -307,6 +353,9 @@ pub struct Frames<'r> {
     world_from_vehicle: Option<Affine3A>,
     warnings: Vec<String>,
     cuts_seen: usize,
+    /// Messages that declare `is_dense` but hold NaN points: the index of their warning, their
+    /// count, the first one's index and NaN points.
+    dense_with_nan: Option<(usize, usize, usize, usize)>,
 }
 
 impl Frames<'_> {
@@ -334,6 +383,9 @@ impl Frames<'_> {
                     Ordering::AsStored => None,
                 };
                 let read = self.reader.read_message(&self.provenance, &message, setup);
+                if read.is_ok() && self.reader.declared_dense() && self.reader.nan_no_returns() > 0 {
+                    self.warn_dense_with_nan(&topic, message.index);
+                }
                 self.message = Some(message);
                 read
             }
@@ -342,21 +394,22 @@ impl Frames<'_> {
                 self.next_file += 1;
                 self.message = None;
                 self.world_from_vehicle = file.world_from_vehicle;
-                let layout = match InputLayout::of_file(&file.path) {
-                    Ok(l) => l,
-                    Err(e) => return Some(Err(e)),
-                };
-                self.provenance = Provenance::file(file.path.clone(), layout);
-                match self.ordering {
-                    Ordering::Ordered(setup) => self.reader.read(&file.path, setup),
+                let read = match self.ordering {
+                    Ordering::Ordered(setup) => {
+                        self.reader.read(&file.path, setup).map(|ms| (ms, self.reader.layout()))
+                    }
                     Ordering::AsStored => {
                         let t0 = std::time::Instant::now();
-                        read_as_stored(&file.path).map(|cloud| {
+                        read_as_stored_as(&file.path, self.recording.layout).map(|(cloud, layout)| {
                             self.reader.set_cloud(cloud);
-                            t0.elapsed().as_secs_f64() * 1e3
+                            (t0.elapsed().as_secs_f64() * 1e3, layout)
                         })
                     }
-                }
+                };
+                read.map(|(ms, (layout, basis))| {
+                    self.provenance = Provenance::file(file.path.clone(), layout, basis);
+                    ms
+                })
             }
         };
         let read_ms = match read_ms {
@@ -379,8 +432,27 @@ impl Frames<'_> {
         }))
     }
 
-    /// The warnings so far: each bag file found cut short, naming the last message read.
+    /// The warnings so far: each bag file found cut short, naming the last message read; the
+    /// messages that declare `is_dense = true` but hold NaN points (read as no-returns).
     pub fn warnings(&self) -> &[String] {
         &self.warnings
+    }
+
+    /// Counts message `index` of `topic` among those that declare `is_dense` but hold NaN points,
+    /// keeping one warning for them all.
+    fn warn_dense_with_nan(&mut self, topic: &str, index: usize) {
+        let nan = self.reader.nan_no_returns();
+        let (at, count, first, first_nan) = match self.dense_with_nan {
+            Some((at, count, first, first_nan)) => (at, count + 1, first, first_nan),
+            None => {
+                self.warnings.push(String::new());
+                (self.warnings.len() - 1, 1, index, nan)
+            }
+        };
+        self.dense_with_nan = Some((at, count, first, first_nan));
+        self.warnings[at] = format!(
+            "warning: {count} message(s) of `{topic}` declare is_dense = true but hold NaN points (first: message \
+             {first}, {first_nan} points); read as no-returns (not ground, kept in place)"
+        );
     }
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::InputLayout;
+use super::{InputLayout, LayoutBasis};
 
 /// Where a frame came from.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -15,6 +15,8 @@ pub struct Provenance {
     pub file: PathBuf,
     /// How its points were laid out.
     pub layout: InputLayout,
+    /// What decided the layout (name, content or `--layout`).
+    pub layout_by: LayoutBasis,
     /// The bag's topic, for a message.
     pub topic: Option<String>,
     /// The message's index among the topic's messages (0 on), for a message.
@@ -25,8 +27,8 @@ pub struct Provenance {
 
 impl Provenance {
     /// A file's.
-    pub fn file(file: PathBuf, layout: InputLayout) -> Self {
-        Self { file, layout, topic: None, message: None, log_time_ns: None }
+    pub fn file(file: PathBuf, layout: InputLayout, layout_by: LayoutBasis) -> Self {
+        Self { file, layout, layout_by, topic: None, message: None, log_time_ns: None }
     }
 
     /// A bag message's.
@@ -34,6 +36,7 @@ impl Provenance {
         Self {
             file: bag,
             layout: InputLayout::PointCloud2,
+            layout_by: LayoutBasis::Name,
             topic: Some(topic.to_string()),
             message: Some(index),
             log_time_ns: Some(log_time_ns),
