@@ -2,11 +2,12 @@
 //!
 //! Two layouts ([`FrameFormat`]):
 //!
-//! - **SemanticKITTI**: a dataset root holds `sequences/NN/velodyne/NNNNNN.bin` with `sequences/NN/labels/NNNNNN.label`
-//! beside them (SemanticKITTI's, KITTI-360 and others converted to it, and `groundtruth dataset`'s
-//! output); a single sequence's folder holding `velodyne/` and `labels/` is taken too. Frames are
-//! sorted by file name. `.bin`: float32 `x y z intensity` records (sensor frame); `.label`: one
-//! uint32 per point, the class id in the lower 16 bits (the instance in the upper).
+//! - **SemanticKITTI**: a dataset root holds `sequences/NN/velodyne/NNNNNN.bin` with
+//!   `sequences/NN/labels/NNNNNN.label` beside them (SemanticKITTI's, KITTI-360 and others
+//!   converted to it, and `groundtruth dataset`'s output); a single sequence's folder holding
+//!   `velodyne/` and `labels/` is taken too. Frames are sorted by file name. `.bin`: float32
+//!   `x y z intensity` records (sensor frame); `.label`: one uint32 per point, the class id in the
+//!   lower 16 bits (the instance in the upper).
 //! - **nuScenes-lidarseg**: a folder holding `lidar/NAME.pcd.bin` (nuScenes sweeps: float32 `x y z
 //!   intensity ring`) with `lidarseg/NAME_lidarseg.bin` beside them (one uint8 class id per point):
 //!   nuScenes keeps the sweeps as `samples/LIDAR_TOP/<name>.pcd.bin` and the labels as
@@ -298,7 +299,7 @@ impl LabelledFrame {
     /// The KITTI records of the `.bin`'s bytes `bin` and the `.label`'s raw labels, checked
     /// against each other.
     fn kitti_from_bytes(&self, bin: &[u8]) -> Result<(Vec<[f32; 4]>, Vec<u32>), DatasetError> {
-        if bin.len() % 16 != 0 {
+        if !bin.len().is_multiple_of(16) {
             return Err(DatasetError::Truncated { path: self.bin.clone(), bytes: bin.len() as u64 });
         }
         let labels = self.read_labels(bin.len() / 16)?;
