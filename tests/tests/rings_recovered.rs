@@ -8,21 +8,14 @@ use classifier::ordering::{CloudBuffer, OrderingReport, RecoveredOrder, SensorSe
 use gt_tests::{ScanSpec, scan_spec};
 use sim::OrderedCloud;
 
-/// Every spinning roof rig: the catalogue's and the older models'.
-const RIGS: [&str; 12] = [
-    "vlp16-roof",
-    "hdl64e-roof",
-    "os1-64-roof",
-    "os1-128-roof",
-    "hdl32e-roof",
-    "vlp32c-roof",
-    "vls128-roof",
-    "os0-128-roof",
-    "os2-128-roof",
-    "pandar64-roof",
-    "pandar-xt32-roof",
-    "rs-helios-5515-roof",
-];
+/// Every spinning roof rig (the catalogue's and the older models'): the presets named
+/// `<model>-roof` (the LUX roof rigs are `lux-roof-4` and the like).
+fn spinning_roof_rigs() -> Vec<&'static str> {
+    let rigs: Vec<&str> =
+        sim::rig::PRESETS.iter().copied().filter(|n| n.ends_with("-roof") && !n.starts_with("lux")).collect();
+    assert_eq!(rigs.len(), 12, "{rigs:?}");
+    rigs
+}
 
 /// Frame 0 of the garage (every laser, up or down, has returns) with `rig`, and the rig.
 fn scan(rig: &str) -> (OrderedCloud, sim::Rig) {
@@ -68,7 +61,7 @@ fn order_without_rig(cloud: &OrderedCloud, rig: &sim::Rig, order: &[usize]) -> (
 
 #[test]
 fn every_roof_sensor_is_named_and_its_rings_and_columns_recovered_in_both_orders() {
-    for rig_name in RIGS {
+    for rig_name in spinning_roof_rigs() {
         let (cloud, rig) = scan(rig_name);
         let spec = &rig.sensors[0].spec;
         let model = spec.model_name();

@@ -163,16 +163,7 @@ impl DatasetLayout {
             for bin in bins {
                 let stem = bin.file_stem().and_then(|s| s.to_str()).unwrap_or_default().to_string();
                 let label = labels.join(format!("{stem}.label"));
-                if !label.is_file() {
-                    return Err(DatasetError::MissingLabel { bin, label });
-                }
-                frames.push(LabelledFrame {
-                    sequence: id.clone(),
-                    stem,
-                    bin,
-                    label,
-                    format: FrameFormat::SemanticKitti,
-                });
+                frames.push(LabelledFrame::with_label(&id, stem, bin, label, FrameFormat::SemanticKitti)?);
             }
             sequences.push(Sequence { id, dir: seq, frames });
         }
@@ -209,16 +200,7 @@ impl DatasetLayout {
         let mut frames = Vec::with_capacity(bins.len());
         for (stem, bin) in bins {
             let label = lidarseg.join(format!("{stem}_lidarseg.bin"));
-            if !label.is_file() {
-                return Err(DatasetError::MissingLabel { bin, label });
-            }
-            frames.push(LabelledFrame {
-                sequence: id.clone(),
-                stem,
-                bin,
-                label,
-                format: FrameFormat::NuscenesLidarseg,
-            });
+            frames.push(LabelledFrame::with_label(&id, stem, bin, label, FrameFormat::NuscenesLidarseg)?);
         }
         let sequences = vec![Sequence { id, dir: dir.to_path_buf(), frames }];
         Ok(Self { root: dir.to_path_buf(), sequences, format: FrameFormat::NuscenesLidarseg })
@@ -231,6 +213,20 @@ impl DatasetLayout {
 }
 
 impl LabelledFrame {
+    /// The frame of `bin` with its labels in `label` (refused when that file is missing).
+    fn with_label(
+        sequence: &str,
+        stem: String,
+        bin: PathBuf,
+        label: PathBuf,
+        format: FrameFormat,
+    ) -> Result<Self, DatasetError> {
+        if !label.is_file() {
+            return Err(DatasetError::MissingLabel { bin, label });
+        }
+        Ok(Self { sequence: sequence.to_string(), stem, bin, label, format })
+    }
+
     /// Reads the frame's points in file order with their classes (SemanticKITTI ids) and, for a
     /// nuScenes sweep, their rings; checked as [`LabelledFrame::read`] checks a SemanticKITTI frame,
     /// a nuScenes sweep as [`sim::io::nuscenes`] reads it (20-byte records, whole rings, one label
