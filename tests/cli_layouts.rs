@@ -85,9 +85,11 @@ fn a_nuscenes_sweep_is_read_by_name_content_or_flag_with_its_rings() {
     let out = ok(classify(&renamed, &dir.join("by_flag"), &["--layout", "nuscenes"]));
     assert!(out.contains("by --layout"), "{out}");
     assert_eq!(std::fs::read(dir.join("by_flag/frame_000000.ground")).unwrap(), by_name);
-    let out = ok(classify(&renamed, &dir.join("as_kitti"), &["--layout", "kitti"]));
-    assert!(out.contains("read as KITTI .bin (x y z intensity), by --layout"), "{out}");
-    assert_eq!(std::fs::read(dir.join("as_kitti/frame_000000.ground")).unwrap().len(), n * 20 / 16);
+    // Read as the KITTI records the user asked for, the bytes hold no ring order: refused, never
+    // decided on a table they do not fit.
+    let e = err(classify(&renamed, &dir.join("as_kitti"), &["--layout", "kitti"]));
+    assert!(e.contains("renamed.bin") && e.contains("no ring order can be recovered"), "{e}");
+    assert!(!dir.join("as_kitti/frame_000000.ground").exists());
 
     // bench classify says the layout and what decided it in its JSON.
     let out = ok(run(&["bench", "classify", "--input", s(&renamed), "--repeats", "1"]));
