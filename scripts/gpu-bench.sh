@@ -10,8 +10,8 @@
 #   scripts/gpu-bench.sh > gpu-bench.json           # WGPU_ADAPTER_NAME=... to pick an adapter
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BIN=${GROUNDTRUTH:-target/release/groundtruth}
-[ -x "$BIN" ] || cargo build --release --bin groundtruth >&2
+BIN=${GROUNDTRUTH:-target/dist/groundtruth}
+[ -x "$BIN" ] || cargo build --profile dist --features full --bin groundtruth >&2
 scale=${FRAMES_SCALE:-1}
 n() { python3 -c "import sys; print(max(1, round($1 * $scale)))"; }
 work=$(mktemp -d)

@@ -106,10 +106,5 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn adapter(backend: &str) -> Option<String> {
-    #[cfg(feature = "gpu")]
-    if backend == "gpu" {
-        return sim::cast::gpu::adapter_description().ok();
-    }
-    let _ = backend;
-    None
+    (backend == "gpu").then(sim::cast::gpu_adapter).and_then(Result::ok)
 }

@@ -18,6 +18,9 @@ use anyhow::Context;
 use classifier::FrameInput;
 use classifier::recording::{self, FrameReader, Ordering, Recording};
 
+/// The rig scanned when `--rig` is not given.
+const SCANNED_RIG: &str = "os1-128-roof";
+
 /// Arguments of `groundtruth bench classify`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -27,11 +30,11 @@ pub struct Args {
     /// Scene name or TOML file.
     #[arg(long, default_value = "city")]
     scene: String,
-    /// Rig name or TOML file (with `--input`: the beam table for `.bin` files; left at its default,
-    /// `.bin` files are ordered on the sensor recovered from them, as `classify` does without
-    /// `--rig`).
-    #[arg(long, default_value = "os1-128-roof")]
-    rig: String,
+    /// Rig name or TOML file: the scanned rig (default `os1-128-roof`), or with `--input` the
+    /// sensor of the files; without it, files are ordered on the sensor recovered from their data,
+    /// as `classify` does without `--rig`.
+    #[arg(long)]
+    rig: Option<String>,
     /// Frames to scan.
     #[arg(long, default_value_t = 3)]
     frames: usize,
@@ -84,7 +87,7 @@ fn ms(t: Instant) -> f64 {
 /// `order_ms` and `classify_ms`; `total_ms` per message is the pass's time over its messages.
 fn run_bag(args: &Args, recording: &Recording) -> anyhow::Result<()> {
     let topic = recording.topic().unwrap_or_default();
-    let rig = (args.rig != "os1-128-roof").then_some(args.rig.as_str());
+    let rig = args.rig.as_deref();
     let setup = recording::sensor_setup(rig, args.calibration.as_deref())?;
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
     let (mut read, mut order, mut cls, mut per_message) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -131,11 +134,7 @@ fn run_bag(args: &Args, recording: &Recording) -> anyhow::Result<()> {
 fn run_files(args: &Args, recording: &Recording) -> anyhow::Result<()> {
     let input = recording.path();
     let files: Vec<std::path::PathBuf> = recording.files().iter().map(|f| f.path.clone()).collect();
-    let rig = if args.rig == "os1-128-roof" && files.iter().any(|f| f.extension().is_some_and(|e| e == "bin")) {
-        None
-    } else {
-        Some(args.rig.as_str())
-    };
+    let rig = args.rig.as_deref();
     let setup = recording::sensor_setup(rig, args.calibration.as_deref())?;
     let repeats = args.repeats.max(1);
     let mut method = super::common::method(&args.method, args.seed, args.model.as_deref())?;
@@ -243,7 +242,7 @@ fn run_in_pool(args: &Args) -> anyhow::Result<()> {
     }
     let frames = super::common::scan_spec(&groundtruth_scenario::ScanSpec {
         scene: args.scene.clone(),
-        rig: args.rig.clone(),
+        rig: args.rig.clone().unwrap_or_else(|| SCANNED_RIG.to_string()),
         seed: args.seed,
         frames: args.frames as u64,
         ..Default::default()
@@ -272,7 +271,7 @@ fn run_in_pool(args: &Args) -> anyhow::Result<()> {
     let mut out = serde_json::json!({
         "method": args.method,
         "scene": args.scene,
-        "rig": args.rig,
+        "rig": args.rig.as_deref().unwrap_or(SCANNED_RIG),
         "frames": frames.len(),
         "repeats": repeats,
         "rows": first.rows,

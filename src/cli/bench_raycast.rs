@@ -180,10 +180,7 @@ fn device_json(d: &sim::cast::DeviceStats, rays: usize) -> serde_json::Value {
 
 /// The GPU adapter's description, or null.
 fn adapter() -> Option<String> {
-    #[cfg(feature = "gpu")]
-    return sim::cast::gpu::adapter_description().ok();
-    #[cfg(not(feature = "gpu"))]
-    None
+    sim::cast::gpu_adapter().ok()
 }
 
 /// User + system CPU seconds of this process so far (Linux `/proc/self/stat`), or `None`.

@@ -21,12 +21,9 @@ pub fn run(_args: Args) -> anyhow::Result<()> {
     }
     println!("casting backends:");
     println!("  bvh (production), parry (reference)");
-    #[cfg(feature = "gpu")]
-    match sim::cast::gpu::adapter_description() {
+    match sim::cast::gpu_adapter() {
         Ok(adapter) => println!("  gpu: {adapter}"),
         Err(e) => println!("  gpu: unavailable: {e}"),
     }
-    #[cfg(not(feature = "gpu"))]
-    println!("  gpu: not in this build (cargo feature `gpu`)");
     Ok(())
 }

@@ -209,6 +209,10 @@ fn from_dataset(
 
 /// Runs `train --method learned`.
 pub fn run(args: &LearnedArgs<'_>) -> anyhow::Result<()> {
+    // Before any scan is made for it.
+    if !classifier::learned::train::BUILT {
+        anyhow::bail!("train --method learned: {}", classifier::learned::train::NOT_BUILT);
+    }
     let t0 = Instant::now();
     let section = match args.config {
         Some(path) => DatasetConfig::load(path, false)?.train,

@@ -91,6 +91,46 @@ fn every_roof_sensor_is_named_and_its_rings_and_columns_recovered_in_both_orders
     }
 }
 
+/// A driver's flat cloud with a ring field (the laser id: the channel's index in the vendor's
+/// table, not in elevation order for most makes), in firing order, read without a rig: the sensor
+/// is named from the rings' elevations, each ring goes to its own row, and the points land in their
+/// simulated cells (never the HDL-64E's 64 x 2,170 grid).
+#[test]
+fn every_roof_sensor_read_from_a_ring_field_without_a_rig_gets_its_own_table() {
+    use classifier::ordering::PointAttributes;
+    for rig_name in spinning_roof_rigs() {
+        let (cloud, rig) = scan(rig_name);
+        let spec = &rig.sensors[0].spec;
+        let model = spec.model_name();
+        let pattern = spec.pattern();
+        let ranks = firing_ranks(spec, cloud.rows);
+        let order = sim::io::kitti::firing_order(&cloud, &ranks, pattern.frame_period_s / pattern.cols as f64);
+        let sensor_from_vehicle = rig.sensors[0].mount.vehicle_from_sensor().inverse();
+        let (bin, _, n) = sim::io::kitti::encode_in_order(&cloud, &order, Some(&sensor_from_vehicle)).expect("encode");
+        let pts = sim::io::kitti::points_from_bytes(std::path::Path::new("f.bin"), &bin, None).expect("read");
+        let plane = cloud.rows * cloud.cols;
+        let rings: Vec<u16> = order.iter().map(|&cell| ranks[(cell % plane) / cloud.cols] as u16).collect();
+        let attributes = PointAttributes { rings: Some(&rings), ..PointAttributes::default() };
+        let (mut out, mut report) = (CloudBuffer::default(), OrderingReport::default());
+        SensorSetup::default().order_flat(&pts.points, &attributes, &mut out, &mut report).expect("ordered");
+        let grid = out.cloud();
+        let what = format!("{rig_name}: {}", report.summary());
+        let sensor = report.sensor.as_ref().unwrap_or_else(|| panic!("{what}: no sensor recovered"));
+        assert_eq!(sensor.model, Some(model.as_str()), "{what}");
+        assert_eq!(sensor.order, RecoveredOrder::RingField, "{what}");
+        assert_eq!((grid.rows, grid.cols), (cloud.rows, cloud.cols), "{what}");
+        let grid_plane = grid.rows * grid.cols;
+        let right = order
+            .iter()
+            .zip(&report.cell_of_point)
+            .filter(|(truth, got)| got.is_some_and(|c| c as usize % grid_plane == **truth % plane))
+            .count() as f64
+            / n.max(1) as f64;
+        eprintln!("{what}: {right:.5} in their simulated cell");
+        assert!(right >= 0.999, "{what}: {right:.5} in their simulated cell");
+    }
+}
+
 /// The target of the way in without a rig: each roof sensor's `rural` frame (seed 31337) written as
 /// a ring-less KITTI `.bin` and classified by `learned` without a rig (the sensor recovered) and
 /// with its rig: F1 within 0.005. Prints the figures and the ordering's milliseconds per thousand

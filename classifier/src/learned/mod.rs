@@ -20,7 +20,6 @@ pub mod features;
 pub mod forest;
 pub mod ground_map;
 pub mod model;
-#[cfg(feature = "train")]
 pub mod train;
 
 use std::time::Instant;

@@ -1,5 +1,7 @@
-//! Training the learned method (cargo feature `train`): labelled frames of our own scans in, a
-//! [`LearnedModel`] out.
+//! Training the learned method: labelled frames of our own scans in, a [`LearnedModel`] out. The
+//! training set is always built; growing the trees needs the cargo feature `train` (hessboost:
+//! minutes of build that a user who only classifies should not wait for), and [`train`] says so
+//! without it.
 //!
 //! The trees come from **hessboost** (a maintained, pure-Rust gradient-boosting library with
 //! XGBoost's parameters): `binary:logistic`, `tree_method = hist`, `grow_policy = symmetric`
@@ -16,6 +18,7 @@
 //! decision threshold (the ground probability that maximises F1 on them) and to report scores.
 //! Deterministic for a seed.
 
+#[cfg(feature = "train")]
 use hessboost::prelude::{DMatrix, HessboostError, Objective, TrainingParams, TreeMethod, train as train_booster};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -208,8 +211,15 @@ pub struct TrainReport {
     pub seconds: f64,
 }
 
+/// What [`train`] says in a build without the cargo feature `train`.
+pub const NOT_BUILT: &str = "this build cannot train (no cargo feature `train`): build with `--features train` (`cargo install --path . --features full`)";
+
+/// Whether this build can train (the cargo feature `train`).
+pub const BUILT: bool = cfg!(feature = "train");
+
 /// Converts one of hessboost's trees (grown with `grow_policy = symmetric`) into an
 /// [`ObliviousTree`]; its leaves scaled by `weight`. Refused if the tree is not symmetric.
+#[cfg(feature = "train")]
 pub fn oblivious_from(tree: &hessboost::tree::RegTree, weight: f32) -> Result<ObliviousTree> {
     let nodes = tree.nodes();
     let depth = tree.depth();
@@ -256,22 +266,14 @@ pub fn oblivious_from(tree: &hessboost::tree::RegTree, weight: f32) -> Result<Ob
     Ok(ObliviousTree { features, thresholds, leaves })
 }
 
+#[cfg(feature = "train")]
 fn library_error(e: HessboostError) -> ClassifyError {
     ClassifyError::Training(format!("hessboost: {e}"))
 }
 
-/// Trains a model on `set`; `trained_on` describes the data for the model file.
-pub fn train(
-    set: &TrainingSet,
-    params: &TrainParams,
-    trained_on: serde_json::Value,
-) -> Result<(LearnedModel, TrainReport)> {
-    params.validate()?;
-    let ground = set.labels.iter().filter(|&&y| y > 0.5).count();
-    if ground == 0 || ground == set.len() {
-        return Err(ClassifyError::TrainingSet { ground, non_ground: set.len() - ground });
-    }
-    let t0 = std::time::Instant::now();
+/// The trees grown on `set` (hessboost) and their base score.
+#[cfg(feature = "train")]
+fn boost(set: &TrainingSet, params: &TrainParams) -> Result<(f32, Vec<ObliviousTree>)> {
     let dtrain = DMatrix::from_dense(&set.rows, set.len(), FEATURE_COUNT)
         .and_then(|m| m.with_labels(&set.labels))
         .map_err(library_error)?;
@@ -290,10 +292,32 @@ pub fn train(
     }
     let hparams = builder.build().map_err(library_error)?;
     let booster = train_booster(&hparams, &dtrain, params.trees).map_err(library_error)?;
-    let seconds = t0.elapsed().as_secs_f64();
     let trees: Vec<ObliviousTree> =
         booster.trees().iter().zip(booster.tree_weights()).map(|(t, w)| oblivious_from(t, w)).collect::<Result<_>>()?;
-    let mut model = LearnedModel::new(booster.base_score(), 0.5, trees);
+    Ok((booster.base_score(), trees))
+}
+
+/// Without the cargo feature `train`: refused ([`NOT_BUILT`]).
+#[cfg(not(feature = "train"))]
+fn boost(_set: &TrainingSet, _params: &TrainParams) -> Result<(f32, Vec<ObliviousTree>)> {
+    Err(ClassifyError::Training(NOT_BUILT.to_string()))
+}
+
+/// Trains a model on `set`; `trained_on` describes the data for the model file.
+pub fn train(
+    set: &TrainingSet,
+    params: &TrainParams,
+    trained_on: serde_json::Value,
+) -> Result<(LearnedModel, TrainReport)> {
+    params.validate()?;
+    let ground = set.labels.iter().filter(|&&y| y > 0.5).count();
+    if ground == 0 || ground == set.len() {
+        return Err(ClassifyError::TrainingSet { ground, non_ground: set.len() - ground });
+    }
+    let t0 = std::time::Instant::now();
+    let (base_score, trees) = boost(set, params)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let mut model = LearnedModel::new(base_score, 0.5, trees);
     // The threshold: the best F1 on the held-out frames, over probabilities 0.05 .. 0.95.
     let (mut report_f1, mut report_p, mut report_r, mut nitsch_f1) = (f64::NAN, f64::NAN, f64::NAN, f64::NAN);
     if !set.valid_labels.is_empty() {
@@ -356,7 +380,7 @@ pub fn train(
     Ok((model, report))
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "train"))]
 mod tests {
     use super::*;
     use hessboost::prelude::Iterations;

@@ -22,6 +22,10 @@ use crate::error::{ClassifyError, Result};
 /// 10 Hz turn, so 2,083 columns would make every ring share cells.
 pub const KITTI_COLUMNS: usize = 2170;
 
+/// Beam counts an organized KITTI-layout frame is looked for with when no sensor is given, most
+/// first (an image read with too many rows repeats its elevations and is not taken).
+const ORGANIZED_BEAMS_UNGIVEN: [usize; 4] = [128, 64, 32, 16];
+
 /// Largest mean spread of the elevations within the rows of a candidate organized layout, degrees:
 /// an organized image's row is one beam (spread about 0.1 deg with the beams' own azimuth offsets
 /// and noise), a wrong layout mixes beams (spread of several degrees).
@@ -36,16 +40,17 @@ pub struct SensorSetup {
     pub vehicle_from_sensor: Affine3A,
     /// Lasers of a calibration file, checked against organized clouds' rows.
     pub calibrated_lasers: Option<usize>,
-    /// Whether the sensor was not given (no rig, no calibration file): a flat cloud without a ring
-    /// field is then ordered on the sensor recovered from its data ([`super::recover`]), `table`
-    /// (the HDL-64E nominal one) serving only organized frames and ring fields.
+    /// Whether the sensor was not given (no rig, no calibration file): a flat cloud is then ordered
+    /// on the sensor recovered from its data ([`super::recover`]: from its point order, or from its
+    /// ring field where it has one), `table` (the HDL-64E nominal one) serving only to detect
+    /// organized KITTI-layout frames of 64 rows.
     pub recover: bool,
 }
 
 impl Default for SensorSetup {
-    /// No sensor given: flat clouds are ordered on the sensor recovered from their data; the
-    /// HDL-64E nominal table with [`KITTI_COLUMNS`] columns orders organized frames and ring
-    /// fields; no mount (points stay in the sensor frame).
+    /// No sensor given: flat clouds (with or without a ring field) are ordered on the sensor
+    /// recovered from their data; the HDL-64E nominal table with [`KITTI_COLUMNS`] columns orders
+    /// organized 64-row KITTI-layout frames; no mount (points stay in the sensor frame).
     fn default() -> Self {
         Self {
             table: BeamTable::hdl64e(KITTI_COLUMNS),
@@ -112,8 +117,11 @@ impl SensorSetup {
         cloud: &mut CloudBuffer,
         report: &mut OrderingReport,
     ) -> Result<()> {
-        if self.recover && attributes.rings.is_none() {
-            return super::recover::order_recovered(points, attributes, self.vehicle_from_sensor, cloud, report);
+        if self.recover {
+            return match attributes.rings {
+                None => super::recover::order_recovered(points, attributes, self.vehicle_from_sensor, cloud, report),
+                Some(_) => super::recover::order_ring_field(points, attributes, self.vehicle_from_sensor, cloud, report),
+            };
         }
         order_cloud_into(
             points,
@@ -142,7 +150,13 @@ impl SensorSetup {
         report: &mut OrderingReport,
     ) -> Result<()> {
         let beams = self.table.elevations_rad.len();
-        let Some(layout) = OrganizedLayout::detect(records, beams) else {
+        // Without a sensor given, an image of any of the usual beam counts.
+        let layout = if self.recover {
+            ORGANIZED_BEAMS_UNGIVEN.iter().find_map(|&b| OrganizedLayout::detect(records, b))
+        } else {
+            OrganizedLayout::detect(records, beams)
+        };
+        let Some(layout) = layout else {
             let attributes = PointAttributes { labels, ..PointAttributes::default() };
             return self.order_flat(records, &attributes, cloud, report);
         };
@@ -155,6 +169,11 @@ impl SensorSetup {
             )));
         }
         let rings: Vec<u16> = (0..records.len()).map(|k| (layout.cell_of_record(k) / layout.cols) as u16).collect();
+        if self.recover {
+            // The image's rows are the rings; the table is the one they show.
+            let attributes = PointAttributes { labels, rings: Some(&rings), ..PointAttributes::default() };
+            return self.order_flat(records, &attributes, cloud, report);
+        }
         // A spinning sensor's image: its own column count over the turn (the table's beams, offsets
         // kept); another table is used as it is.
         let table = if self.table.full_turn {

@@ -19,6 +19,19 @@ use glam::Vec3;
 
 use crate::scene::SceneMesh;
 
+/// The GPU adapter `--backend gpu` would cast on, described (name, API, kind); why not where there
+/// is none, or where this build has no cargo feature `gpu`.
+pub fn gpu_adapter() -> Result<String, String> {
+    #[cfg(feature = "gpu")]
+    return gpu::adapter_description().map_err(|e| e.to_string());
+    #[cfg(not(feature = "gpu"))]
+    Err(GPU_NOT_BUILT.to_string())
+}
+
+/// Why a build without the cargo feature `gpu` has no GPU backend, and how to get one.
+pub const GPU_NOT_BUILT: &str =
+    "not in this build (cargo feature `gpu`: `cargo install --path . --features full`, or `--features gpu`)";
+
 /// A ray: `origin + t * dir` for `t` in `[0, t_max]`; `dir` is unit length so `t` is metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -79,7 +92,7 @@ impl Backend {
             },
             #[cfg(not(feature = "gpu"))]
             Backend::Gpu => {
-                Err(crate::error::SimError::invalid("backend", "gpu", "bvh or parry: this build has no `gpu` feature"))
+                Err(crate::error::SimError::invalid("backend", "gpu", format!("bvh or parry: the GPU backend is {GPU_NOT_BUILT}")))
             }
         }
     }

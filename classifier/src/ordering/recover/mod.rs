@@ -28,6 +28,7 @@
 mod firing;
 pub mod known;
 mod matching;
+pub mod ring_field;
 
 use std::f32::consts::{PI, TAU};
 use std::sync::OnceLock;
@@ -68,6 +69,8 @@ pub enum RecoveredOrder {
     RingMajor,
     /// Firing by firing, the lasers of one firing then the next (the drivers).
     Firing,
+    /// Any order: each point's laser from the cloud's ring field ([`ring_field`]).
+    RingField,
 }
 
 impl RecoveredOrder {
@@ -76,6 +79,7 @@ impl RecoveredOrder {
         match self {
             RecoveredOrder::RingMajor => "ring-major",
             RecoveredOrder::Firing => "firing",
+            RecoveredOrder::RingField => "ring-field",
         }
     }
 }
@@ -103,11 +107,14 @@ pub struct RecoveredSensor {
 impl RecoveredSensor {
     /// One phrase for the ordering report: `matched: hdl32e (...)` or `unnamed sensor: ...`.
     pub fn summary(&self) -> String {
+        let order = match self.order {
+            RecoveredOrder::RingField => "lasers from the ring field".to_string(),
+            o => format!("{} order", o.name()),
+        };
         let how = format!(
-            "{} rings x {} columns, {} order{}",
+            "{} rings x {} columns, {order}{}",
             self.rows,
             self.columns,
-            self.order.name(),
             if self.echoes > 1 { ", dual returns" } else { "" }
         );
         match (self.model, self.mean_error_deg) {
@@ -409,6 +416,28 @@ pub(crate) fn order_recovered<P: InputPoint>(
         // Rows from each point's nearest beam: the beam-table path, with the beams' origins undone.
         report.path = OrderingPath::BeamTable;
     }
+    report.sensor = Some(rec.sensor);
+    Ok(())
+}
+
+/// Orders `points` (sensor frame) that carry a ring field (`attributes.rings`) on the table their
+/// rings show ([`ring_field`]), into `cloud` and `report` (`report.sensor` says what was found);
+/// refused where the rings cannot give a table.
+pub(crate) fn order_ring_field<P: InputPoint>(
+    points: &[P],
+    attributes: &PointAttributes<'_>,
+    vehicle_from_sensor: Affine3A,
+    cloud: &mut CloudBuffer,
+    report: &mut OrderingReport,
+) -> Result<()> {
+    let rings = attributes.rings.unwrap_or_default();
+    if rings.len() != points.len() {
+        return Err(crate::error::ClassifyError::Ordering("rings and points differ in length".into()));
+    }
+    let rec = ring_field::recover_ring_field(points, rings)?;
+    let attributes = PointAttributes { rings: Some(&rec.point_rows), ..*attributes };
+    let params = UnfoldParams::default();
+    order_cloud_into(points, &attributes, &rec.table, vehicle_from_sensor, PathChoice::Auto, &params, cloud, report)?;
     report.sensor = Some(rec.sensor);
     Ok(())
 }
