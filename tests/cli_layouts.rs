@@ -71,8 +71,21 @@ fn a_nuscenes_sweep_is_read_by_name_content_or_flag_with_its_rings() {
     assert!(out.contains("path ring-field") && out.contains("32 rings with points"), "ordered from the rings: {out}");
     let by_name = std::fs::read(dir.join("by_name/frame_000000.ground")).unwrap();
     assert_eq!(by_name.len(), n, "one decision per nuScenes point, not per KITTI record");
-    // How well this synthetic sweep is classified is not checked here: nitsch calls none of it
-    // ground, with or without a rig (open in issue 44; the sweep is no sensor model's scan).
+    // Without a rig the sensor is named from the rings' elevations and the grid is its own (32 x
+    // 540), not the HDL-64E's 64 x 2,170 on which nitsch called none of the sweep ground.
+    assert!(out.contains("sensor matched: hdl32e (32 rings x 540 columns"), "{out}");
+    let (_, classes) = sweep();
+    let (mut tp, mut fp, mut fn_) = (0usize, 0usize, 0usize);
+    for (&d, &c) in by_name.iter().zip(&classes) {
+        match (d == 1, c == 24) {
+            (true, true) => tp += 1,
+            (true, false) => fp += 1,
+            (false, true) => fn_ += 1,
+            _ => {}
+        }
+    }
+    let f1 = 2.0 * tp as f64 / (2 * tp + fp + fn_) as f64;
+    assert!(f1 >= 0.9, "nitsch F1 {f1:.4} on the sweep's flat ground (tp {tp}, fp {fp}, fn {fn_})");
 
     // Renamed `.bin`: recognised by its content, the same decisions.
     let renamed = dir.join("renamed.bin");

@@ -24,21 +24,6 @@ fn scan(rig: &str) -> (OrderedCloud, sim::Rig) {
     (frames.swap_remove(0).cloud, rig)
 }
 
-/// The firing rank of each grid row: the channel's index in a catalogued model's table, else the
-/// top beam first.
-fn firing_ranks(spec: &sim::sensor::SensorSpec, rows: usize) -> Vec<usize> {
-    match spec.catalogued() {
-        Some((entry, _)) => {
-            let mut rank = vec![0; rows];
-            for (row, channel) in entry.channel_of_row().into_iter().enumerate() {
-                rank[row] = channel;
-            }
-            rank
-        }
-        None => (0..rows).map(|r| rows - 1 - r).collect(),
-    }
-}
-
 /// What ordering a `.bin` of `cloud`'s returns in `order` (sensor frame) without a sensor gives:
 /// the report, the ordered grid's shape and the fraction of returns in their simulated cell.
 fn order_without_rig(cloud: &OrderedCloud, rig: &sim::Rig, order: &[usize]) -> (OrderingReport, (usize, usize), f64) {
@@ -69,7 +54,7 @@ fn every_roof_sensor_is_named_and_its_rings_and_columns_recovered_in_both_orders
         let cycle_s = pattern.frame_period_s / pattern.cols as f64;
         let orders = [
             (RecoveredOrder::RingMajor, sim::io::kitti::scan_order(&cloud)),
-            (RecoveredOrder::Firing, sim::io::kitti::firing_order(&cloud, &firing_ranks(spec, cloud.rows), cycle_s)),
+            (RecoveredOrder::Firing, sim::io::kitti::firing_order(&cloud, &spec.firing_ranks(cloud.rows), cycle_s)),
         ];
         for (order_kind, order) in orders {
             let (report, shape, right) = order_without_rig(&cloud, &rig, &order);
@@ -103,7 +88,7 @@ fn every_roof_sensor_read_from_a_ring_field_without_a_rig_gets_its_own_table() {
         let spec = &rig.sensors[0].spec;
         let model = spec.model_name();
         let pattern = spec.pattern();
-        let ranks = firing_ranks(spec, cloud.rows);
+        let ranks = spec.firing_ranks(cloud.rows);
         let order = sim::io::kitti::firing_order(&cloud, &ranks, pattern.frame_period_s / pattern.cols as f64);
         let sensor_from_vehicle = rig.sensors[0].mount.vehicle_from_sensor().inverse();
         let (bin, _, n) = sim::io::kitti::encode_in_order(&cloud, &order, Some(&sensor_from_vehicle)).expect("encode");

@@ -170,6 +170,28 @@ impl SensorSpec {
         .to_string()
     }
 
+    /// The rank of each of `rows` grid rows (0 lowest) in the order a driver writes one firing's
+    /// lasers: the channel's index in a catalogued model's table, else the top beam first. With
+    /// [`crate::io::kitti::firing_order`], a cloud's returns in its driver's point order.
+    ///
+    /// ```
+    /// let spec = sim::sensor::SensorSpec::default_for("vlp16")?;
+    /// assert_eq!(spec.firing_ranks(16)[15], 0); // the top beam fires first
+    /// # Ok::<(), sim::SimError>(())
+    /// ```
+    pub fn firing_ranks(&self, rows: usize) -> Vec<usize> {
+        match self.catalogued() {
+            Some((entry, _)) => {
+                let mut rank = vec![0; rows];
+                for (row, channel) in entry.channel_of_row().into_iter().enumerate().take(rows) {
+                    rank[row] = channel;
+                }
+                rank
+            }
+            None => (0..rows).map(|r| rows - 1 - r).collect(),
+        }
+    }
+
     /// The catalogue entry of a catalogued model and its settings (`None` for the built-in models).
     pub fn catalogued(&self) -> Option<(&'static CatalogueEntry, &CatalogueSpec)> {
         Some(match self {

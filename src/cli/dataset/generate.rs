@@ -11,6 +11,7 @@
 //! frames = 4                                 # per sequence
 //! scenes = ["city", "rural", "highway"]      # scene k of sequence k: cycled
 //! rigs = ["hdl64e-roof", "vlp16-roof"]       # cycled over the scenes' cycles (every pairing)
+//! pairing = "cycled"                         # or "interleaved": rig k and scene k both cycled
 //! scene_seed = [0, 10000]                    # uniform integer, inclusive
 //! mount_z_m = [1.4, 2.4]                     # uniform; absent: the rig's own
 //! pitch_deg = [-3.0, 3.0]                    # (+ = down), absent: the rig's own
@@ -32,6 +33,20 @@ use groundtruth_scenario::{MountOverride, ScanSpec};
 
 use super::config::SequenceConfig;
 
+/// How the drawn sequences pair scenes and rigs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Pairing {
+    /// Scene `k mod scenes`, rig `(k / scenes) mod rigs`: every scene with one rig, then the
+    /// next rig (all pairings once the sequences reach scenes x rigs).
+    #[default]
+    Cycled,
+    /// Scene `k mod scenes`, rig `k mod rigs`: every rig and every scene from the first sequences
+    /// on, each rig with scenes spread over the list (all pairings once the sequences reach their
+    /// least common multiple). For more rigs x scenes than sequences.
+    Interleaved,
+}
+
 /// The `[generate]` table.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -47,6 +62,9 @@ pub struct Generate {
     pub scenes: Vec<String>,
     /// Rigs (single-sensor rigs where mounts are drawn), cycled over the scenes' cycles.
     pub rigs: Vec<String>,
+    /// How sequence `k` pairs a scene and a rig ([`Pairing`]).
+    #[serde(default)]
+    pub pairing: Pairing,
     /// Range of the scene seeds (inclusive).
     #[serde(default)]
     pub scene_seed: Option<[u64; 2]>,
@@ -147,7 +165,10 @@ impl Generate {
         let mut out = Vec::with_capacity(self.sequences as usize);
         for k in 0..self.sequences as usize {
             let scene = self.scenes[k % self.scenes.len()].clone();
-            let rig = self.rigs[(k / self.scenes.len()) % self.rigs.len()].clone();
+            let rig = match self.pairing {
+                Pairing::Cycled => self.rigs[(k / self.scenes.len()) % self.rigs.len()].clone(),
+                Pairing::Interleaved => self.rigs[k % self.rigs.len()].clone(),
+            };
             let z = uniform(&mut rng, self.mount_z_m, 0.01);
             let pitch = uniform(&mut rng, self.pitch_deg, 0.01);
             let roll = uniform(&mut rng, self.roll_deg, 0.01);
