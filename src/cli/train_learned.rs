@@ -6,9 +6,9 @@
 //! frame takes the path a user's recording takes: its KITTI records (sensor frame) are ordered by
 //! [`classifier::ordering::SensorSetup::order_kitti`] with the sequence's rig, so the model learns
 //! on the grids it will meet; a dataset's frames are read through the recordings' reader
-//! ([`classifier::recording::Recording::from_dataset`]), as `eval dataset` reads them. Every second sequence is read in its sensor frame (the mount not
-//! applied), as a recording is read without `--rig`: the model meets tilted and raised frames as
-//! well as level vehicle frames. Frames are scanned and their features computed in parallel; the
+//! ([`classifier::recording::Recording::from_dataset`]), as `eval dataset` reads them. Every
+//! second sequence is read in its sensor frame (the mount not applied), as a recording is read
+//! without `--rig`: the model meets tilted and raised frames as well as level vehicle frames. Frames are scanned and their features computed in parallel; the
 //! training set is assembled in frame order, so the model does not depend on the thread count.
 //! Parameters: the file's `[train]` table, then the command line's flags.
 
