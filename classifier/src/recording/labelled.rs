@@ -85,10 +85,9 @@ impl<'r> Frames<'r> {
             Ordering::Ordered(setup) => Some(setup),
             Ordering::AsStored => None,
         };
-        Some(self.reader.read_labelled(frame, setup).map(|ms| {
+        Some(self.reader.read_labelled(frame, setup).inspect(|_| {
             let (layout, basis) = self.reader.layout();
             self.provenance = Provenance::sequence_file(frame.bin.clone(), &frame.sequence, layout, basis);
-            ms
         }))
     }
 
