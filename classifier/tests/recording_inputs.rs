@@ -207,6 +207,21 @@ fn a_semantickitti_directory_reads_as_labelled_frames_with_their_sequences() {
     assert!(matches!(e, RecordingError::Dataset(_)) && e.to_string().contains("000000.label"), "{e}");
     let e = Recording::open(&d.join("data"), Some("/points")).unwrap_err();
     assert!(e.to_string().contains("--topic applies to a bag"), "{e}");
+    // A nuScenes-lidarseg folder: its sweep as nuScenes records, its class as SemanticKITTI's (24
+    // driveable surface -> 40 road); KITTI records for it are refused.
+    let mini = d.join("mini");
+    std::fs::create_dir_all(mini.join("lidar")).unwrap();
+    std::fs::create_dir_all(mini.join("lidarseg")).unwrap();
+    std::fs::write(mini.join("lidar/tok.pcd.bin"), sim::io::nuscenes::encode(&[[5.0, 1.0, -1.8, 0.3, 2.0]])).unwrap();
+    std::fs::write(mini.join("lidarseg/tok_lidarseg.bin"), [24u8]).unwrap();
+    let recording = Recording::open(&mini, None).unwrap();
+    let mut frames = recording.frames(Ordering::AsStored).unwrap();
+    let f = frames.next_frame().unwrap().unwrap();
+    assert_eq!((f.provenance.layout, f.provenance.sequence.as_deref()), (InputLayout::NuscenesBin, Some("mini")));
+    assert_eq!((f.cloud.label[0], f.cloud.ring[0]), (sim::SemanticClass::ROAD, 2));
+    let e = Recording::open(&mini, None).unwrap().with_layout(Some(classifier::recording::LayoutChoice::Kitti));
+    let e = e.unwrap_err().to_string();
+    assert!(e.contains("--layout kitti") && e.contains("nuScenes"), "{e}");
 }
 
 #[test]

@@ -278,15 +278,21 @@ impl Recording {
 
     /// The same recording with its headerless `.bin` files read in `layout` (`--layout`: KITTI or
     /// nuScenes records, whatever their names and contents say); `None` decides per file
-    /// ([`InputLayout::decide`]). Refused: a layout for a bag, a layout for a file that is not a
+    /// ([`InputLayout::decide`]). Refused: a layout for a bag, KITTI records for a
+    /// nuScenes-lidarseg folder (its sweeps are nuScenes records), a layout for a file that is not a
     /// `.bin` (when its frame is read).
     pub fn with_layout(mut self, layout: Option<LayoutChoice>) -> Result<Self, RecordingError> {
-        if let (Some(choice), Source::Bag { .. }) = (layout, &self.source) {
-            return Err(RecordingError::LayoutOfNonRaw {
-                path: self.path.clone(),
-                choice,
-                named: InputLayout::PointCloud2,
-            });
+        let named = match (layout, &self.source) {
+            (Some(_), Source::Bag { .. }) => Some(InputLayout::PointCloud2),
+            (Some(LayoutChoice::Kitti), Source::Dataset(d))
+                if d.layout.format == crate::dataset::FrameFormat::NuscenesLidarseg =>
+            {
+                Some(InputLayout::NuscenesBin)
+            }
+            _ => None,
+        };
+        if let (Some(choice), Some(named)) = (layout, named) {
+            return Err(RecordingError::LayoutOfNonRaw { path: self.path.clone(), choice, named });
         }
         self.layout = layout;
         Ok(self)
