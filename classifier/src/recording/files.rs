@@ -113,15 +113,21 @@ impl FrameReader {
         self.ordered = false;
     }
 
-    /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
-    /// ordering; for a driver's organized PCD, decoded in order, only the file's read and the header).
-    pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> Result<f64, RecordingError> {
-        let t0 = Instant::now();
+    /// Forgets what the last frame said (its report, layout, NaN count, density, labelled points)
+    /// before the next is read.
+    fn forget_last_frame(&mut self) {
         self.ordered = false;
         self.nan_no_returns = 0;
         self.declared_dense = false;
         self.decided = None;
         self.labelled = None;
+    }
+
+    /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
+    /// ordering; for a driver's organized PCD, decoded in order, only the file's read and the header).
+    pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> Result<f64, RecordingError> {
+        let t0 = Instant::now();
+        self.forget_last_frame();
         let by_name = InputLayout::of_file(path)?;
         if by_name.is_raw() {
             return self.read_raw(path, setup, t0);
@@ -208,10 +214,7 @@ impl FrameReader {
         setup: Option<&SensorSetup>,
     ) -> Result<f64, RecordingError> {
         let t0 = Instant::now();
-        self.ordered = false;
-        self.nan_no_returns = 0;
-        self.decided = None;
-        self.labelled = None;
+        self.forget_last_frame();
         let bad = |reason: String| RecordingError::Message {
             bag: provenance.file.clone(),
             topic: provenance.topic.clone().unwrap_or_default(),
@@ -246,11 +249,7 @@ impl FrameReader {
     /// refuses ([`DatasetError::Classify`], naming the `.bin`).
     pub fn read_labelled(&mut self, frame: &LabelledFrame, setup: Option<&SensorSetup>) -> Result<f64, RecordingError> {
         let t0 = Instant::now();
-        self.ordered = false;
-        self.nan_no_returns = 0;
-        self.declared_dense = false;
-        self.decided = None;
-        self.labelled = None;
+        self.forget_last_frame();
         let points = frame.read_points(self.choice).map_err(Box::new)?;
         let read_ms = t0.elapsed().as_secs_f64() * 1e3;
         self.decided = Some(points.layout);
