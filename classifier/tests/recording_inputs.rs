@@ -1,7 +1,8 @@
 //! The reader of recordings on every input kind, written by the simulator's writers in a temporary
 //! directory: PCD (ours and a driver's), PLY, LAS, KITTI `.bin` with its `.label`, a directory of
-//! them, a ROS 2 bag (with and without a topic, one topic or two); a bag cut short at several
-//! byte offsets reads as the first messages of the whole bag, with a warning naming the last one.
+//! them, a ROS 2 bag (with and without a topic, one topic or two), a SemanticKITTI-layout dataset
+//! (frames with their labels and sequences); a bag cut short at several byte offsets reads as the
+//! first messages of the whole bag, with a warning naming the last one.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -138,6 +139,89 @@ fn every_input_kind_reads_as_ordered_frames_with_provenance() {
     assert!(e.to_string().contains("--topic applies to a bag"), "{e}");
     let e = Recording::open(&d.join("missing"), None).unwrap_err();
     assert!(e.to_string().contains("neither a file nor a directory"), "{e}");
+}
+
+#[test]
+fn a_semantickitti_directory_reads_as_labelled_frames_with_their_sequences() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Sequence 00 holds frames 0 and 1, sequence 01 frame 2; frame 0 also as a plain `.bin` with
+    // its `.label` beside it.
+    let mut written = Vec::new();
+    for (seq, stem, k) in [("00", "000000", 0), ("00", "000001", 1), ("01", "000000", 2)] {
+        let s = d.join("data/sequences").join(seq);
+        std::fs::create_dir_all(s.join("velodyne")).unwrap();
+        std::fs::create_dir_all(s.join("labels")).unwrap();
+        let (bin, label, _) = sim::io::kitti::encode(&frame(k), None).unwrap();
+        std::fs::write(s.join(format!("velodyne/{stem}.bin")), &bin).unwrap();
+        std::fs::write(s.join(format!("labels/{stem}.label")), &label).unwrap();
+        if k == 0 {
+            std::fs::write(d.join("frame_000000.bin"), &bin).unwrap();
+            std::fs::write(d.join("frame_000000.label"), &label).unwrap();
+        }
+        let classes: Vec<u16> = label.chunks_exact(4).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+        written.push((seq, stem, classes));
+    }
+    let setup = vlp16();
+    let recording = Recording::open(&d.join("data"), None).unwrap();
+    assert_eq!(recording.dataset().map(|l| l.sequences.len()), Some(2));
+    let mut frames = recording.frames(Ordering::Ordered(&setup)).unwrap();
+    let mut method = classifier::method("nitsch", &classifier::MethodOptions::default()).unwrap();
+    let mut decisions = Vec::new();
+    for (k, (seq, stem, classes)) in written.iter().enumerate() {
+        let f = frames.next_frame().expect("a frame per .bin").unwrap();
+        let labelled = f.labelled.expect("a labelled frame");
+        // Provenance names the sequence and the `.bin`; the place in the recording and in its
+        // sequence.
+        assert_eq!(f.index, k);
+        assert_eq!(labelled.index_in_sequence, [0, 1, 0][k]);
+        assert_eq!(f.provenance.sequence.as_deref(), Some(*seq));
+        assert!(f.provenance.file.ends_with(format!("sequences/{seq}/velodyne/{stem}.bin")), "{}", f.provenance);
+        assert_eq!((f.provenance.layout, labelled.frame.stem.as_str()), (InputLayout::KittiBin, *stem));
+        // The labels in file order, as written; carried through ordering as the cloud's labels.
+        let got: Vec<u16> = labelled.points.classes.iter().map(|c| c.0).collect();
+        assert_eq!(&got, classes);
+        assert_eq!(labelled.points.records.len(), classes.len());
+        let road = |l: &mut dyn Iterator<Item = u16>| l.filter(|&c| c == sim::SemanticClass::ROAD.0).count();
+        let road_cells = road(&mut f.cloud.label.iter().map(|c| c.0));
+        assert!(road_cells > 1000, "{road_cells}");
+        assert_eq!(road_cells, road(&mut classes.iter().copied()));
+        let ground =
+            method.classify(&classifier::FrameInput { index: f.index, cloud: f.cloud, world_from_vehicle: None });
+        decisions.push(f.decisions_per_point(&ground.unwrap()));
+    }
+    assert!(frames.next_frame().is_none());
+    // A frame decides as the same `.bin` and `.label` read as a plain file.
+    let plain = read_all(&d.join("frame_000000.bin"), None, &setup);
+    assert_eq!(plain[0].3, decisions[0]);
+    // One sequence's folder alone; as stored: `1 x N` in file order with the labels.
+    let one = Recording::open(&d.join("data/sequences/01"), None).unwrap();
+    let mut stored = one.frames(Ordering::AsStored).unwrap();
+    let f = stored.next_frame().unwrap().unwrap();
+    assert_eq!((f.cloud.rows, f.cloud.cols), (1, written[2].2.len()));
+    assert!(f.cloud.label.iter().map(|c| c.0).eq(written[2].2.iter().copied()));
+    assert_eq!(f.provenance.sequence.as_deref(), Some("01"));
+    // A `.bin` without its `.label`: refused, naming it; a topic for a dataset: refused.
+    std::fs::remove_file(d.join("data/sequences/01/labels/000000.label")).unwrap();
+    let e = Recording::open(&d.join("data"), None).unwrap_err();
+    assert!(matches!(e, RecordingError::Dataset(_)) && e.to_string().contains("000000.label"), "{e}");
+    let e = Recording::open(&d.join("data"), Some("/points")).unwrap_err();
+    assert!(e.to_string().contains("--topic applies to a bag"), "{e}");
+    // A nuScenes-lidarseg folder: its sweep as nuScenes records, its class as SemanticKITTI's (24
+    // driveable surface -> 40 road); KITTI records for it are refused.
+    let mini = d.join("mini");
+    std::fs::create_dir_all(mini.join("lidar")).unwrap();
+    std::fs::create_dir_all(mini.join("lidarseg")).unwrap();
+    std::fs::write(mini.join("lidar/tok.pcd.bin"), sim::io::nuscenes::encode(&[[5.0, 1.0, -1.8, 0.3, 2.0]])).unwrap();
+    std::fs::write(mini.join("lidarseg/tok_lidarseg.bin"), [24u8]).unwrap();
+    let recording = Recording::open(&mini, None).unwrap();
+    let mut frames = recording.frames(Ordering::AsStored).unwrap();
+    let f = frames.next_frame().unwrap().unwrap();
+    assert_eq!((f.provenance.layout, f.provenance.sequence.as_deref()), (InputLayout::NuscenesBin, Some("mini")));
+    assert_eq!((f.cloud.label[0], f.cloud.ring[0]), (sim::SemanticClass::ROAD, 2));
+    let e = Recording::open(&mini, None).unwrap().with_layout(Some(classifier::recording::LayoutChoice::Kitti));
+    let e = e.unwrap_err().to_string();
+    assert!(e.contains("--layout kitti") && e.contains("nuScenes"), "{e}");
 }
 
 #[test]

@@ -16,7 +16,7 @@ use classifier::dataset::score::{RANGE_BANDS, band_name};
 use classifier::dataset::{
     DatasetLayout, EvalOptions, FrameFormat, FrameView, MethodScore, Protocol, evaluate, report,
 };
-use classifier::recording::{self, InputLayout, LayoutBasis, LayoutChoice, Ordering, Provenance, Recording};
+use classifier::recording::{self, InputLayout, LayoutBasis, LayoutChoice, Ordering, Recording};
 use classifier::registry::{MethodOptions, ResolvedMethod};
 
 /// What `eval --dataset` needs from the command line.
@@ -143,8 +143,7 @@ pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
         let (frame_layout, basis) = view.layout;
         let plain = frame_layout == InputLayout::KittiBin && basis == LayoutBasis::Name;
         if !plain && view.method == args.methods[0] {
-            let provenance = Provenance::file(view.frame.bin.clone(), frame_layout, basis);
-            if let Some(line) = super::common::layout_line(&provenance) {
+            if let Some(line) = super::common::layout_line(view.provenance) {
                 println!("{line}");
             }
             read_as.push(serde_json::json!({

@@ -5,9 +5,10 @@
 //! (`--dataset DIR`, whose `manifest.json` names each sequence's rig and mount). Either way every
 //! frame takes the path a user's recording takes: its KITTI records (sensor frame) are ordered by
 //! [`classifier::ordering::SensorSetup::order_kitti`] with the sequence's rig, so the model learns
-//! on the grids it will meet. Every second sequence is read in its sensor frame (the mount not
-//! applied), as a recording is read without `--rig`: the model meets tilted and raised frames as
-//! well as level vehicle frames. Frames are scanned and their features computed in parallel; the
+//! on the grids it will meet; a dataset's frames are read through the recordings' reader
+//! ([`classifier::recording::Recording::from_dataset`]), as `eval dataset` reads them. Every
+//! second sequence is read in its sensor frame (the mount not applied), as a recording is read
+//! without `--rig`: the model meets tilted and raised frames as well as level vehicle frames. Frames are scanned and their features computed in parallel; the
 //! training set is assembled in frame order, so the model does not depend on the thread count.
 //! Parameters: the file's `[train]` table, then the command line's flags.
 
@@ -18,6 +19,7 @@ use anyhow::{Context, bail};
 use classifier::learned::Extractor;
 use classifier::learned::train::{TrainParams, TrainingSet, train};
 use classifier::ordering::{CloudBuffer, OrderingReport, SensorSetup};
+use classifier::recording::{Ordering, Recording};
 use rayon::prelude::*;
 use sim::SemanticClass;
 
@@ -99,10 +101,20 @@ fn contribution(
 ) -> anyhow::Result<TrainingSet> {
     let (mut buffer, mut report) = (CloudBuffer::default(), OrderingReport::default());
     frame_through_the_real_path(records, labels, setup, &mut buffer, &mut report)?;
+    contribution_of(buffer.cloud(), (ordinal, sequence), params)
+}
+
+/// One ordered, labelled frame's part of the training set (frame `ordinal` of sequence number
+/// `sequence`).
+fn contribution_of(
+    cloud: &sim::OrderedCloud,
+    (ordinal, sequence): (u64, usize),
+    params: &TrainParams,
+) -> anyhow::Result<TrainingSet> {
     let mut extractor = Extractor::new()?;
     let mut set = TrainingSet::default();
     let held_out = params.validation_every > 0 && sequence % params.validation_every == 0;
-    set.add_frame(&mut extractor, buffer.cloud(), ordinal, held_out, params)?;
+    set.add_frame(&mut extractor, cloud, ordinal, held_out, params)?;
     Ok(set)
 }
 
@@ -209,20 +221,23 @@ fn from_dataset(
             layout.sequences.iter().map(|s| (s.id.clone(), setup.clone())).collect()
         }
     };
-    let frames: Vec<(usize, classifier::dataset::LabelledFrame)> =
-        layout.sequences.iter().enumerate().flat_map(|(k, s)| s.frames.iter().map(move |f| (k, f.clone()))).collect();
+    // Each frame (sequence number, place in it) read as a recording of its own, in parallel.
+    let frames: Vec<(usize, usize)> =
+        layout.sequences.iter().enumerate().flat_map(|(k, s)| (0..s.frames.len()).map(move |i| (k, i))).collect();
     println!("{}: {} sequences, {} frames", dir.display(), layout.sequences.len(), frames.len());
     let parts: Vec<anyhow::Result<TrainingSet>> = frames
         .par_iter()
         .enumerate()
-        .map(|(ordinal, (sequence, f))| {
-            let setup =
-                setups.get(&f.sequence).with_context(|| format!("sequence `{}` is not in the manifest", f.sequence))?;
+        .map(|(ordinal, &(sequence, place))| {
+            let id = layout.sequences.get(sequence).map(|s| s.id.as_str()).unwrap_or_default();
+            let setup = setups.get(id).with_context(|| format!("sequence `{id}` is not in the manifest"))?;
             // Every second sequence as a recording read without `--rig` (as `read_as` does).
             let setup = &if sequence % 2 == 1 { SensorSetup::default() } else { setup.clone() };
-            let (records, labels) = f.read()?;
-            contribution(&records, &labels, setup, (ordinal as u64, *sequence), params)
-                .with_context(|| format!("`{}`", f.bin.display()))
+            let recording = Recording::from_dataset(layout.part(sequence, place..place + 1));
+            let mut frames = recording.frames(Ordering::Ordered(setup))?;
+            let frame = frames.next_frame().with_context(|| format!("sequence `{id}`: no frame {place}"))??;
+            contribution_of(frame.cloud, (ordinal as u64, sequence), params)
+                .with_context(|| format!("`{}`", frame.provenance))
         })
         .collect();
     let mut set = TrainingSet::default();

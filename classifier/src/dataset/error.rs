@@ -94,6 +94,9 @@ pub enum DatasetError {
         /// The error.
         source: std::io::Error,
     },
+    /// A recording that could not be read (the error names it).
+    #[error(transparent)]
+    Recording(Box<crate::recording::RecordingError>),
     /// Ordering or classifying a frame failed.
     #[error("`{path}`: {source}")]
     Classify {
@@ -102,4 +105,15 @@ pub enum DatasetError {
         /// The error.
         source: crate::ClassifyError,
     },
+}
+
+impl From<crate::recording::RecordingError> for DatasetError {
+    /// A labelled dataset's error as it was (the reader of labelled frames gives its errors as
+    /// [`crate::recording::RecordingError::Dataset`]), any other wrapped.
+    fn from(e: crate::recording::RecordingError) -> Self {
+        match e {
+            crate::recording::RecordingError::Dataset(e) => *e,
+            e => DatasetError::Recording(Box::new(e)),
+        }
+    }
 }

@@ -1,6 +1,7 @@
-//! Scoring methods on a labelled dataset: every frame is read and ordered once, as a user's
-//! recording is ([`SensorSetup::order_kitti`]; a nuScenes sweep from its rings,
-//! [`SensorSetup::order_flat`]), every method classifies it, and each decision is
+//! Scoring methods on a labelled dataset: every frame is read and ordered once, through the
+//! recordings' reader as a user's recording is ([`Recording::from_dataset`],
+//! [`crate::recording::FrameReader::read_labelled`]: [`SensorSetup::order_kitti`]; a nuScenes sweep
+//! from its rings, [`SensorSetup::order_flat`]), every method classifies it, and each decision is
 //! scored per input point in the file's own order ([`crate::ordering::decisions_per_point`]),
 //! under a [`Protocol`], by range from the sensor (the file's own coordinates).
 
@@ -9,11 +10,12 @@ use std::time::Instant;
 use sim::OrderedCloud;
 
 use super::DatasetError;
-use super::layout::{DatasetLayout, FramePoints, LabelledFrame};
+use super::layout::{DatasetLayout, LabelledFrame};
 use super::protocol::Protocol;
 use super::score::{FrameScore, MethodScore};
 use crate::methods::{FrameInput, GroundClassifier};
-use crate::ordering::{CloudBuffer, OrderingReport, PointAttributes, SensorSetup, decisions_per_point};
+use crate::ordering::{OrderingReport, SensorSetup};
+use crate::recording::{Ordering, Provenance, Recording};
 
 /// How to evaluate.
 #[derive(Clone, Debug)]
@@ -42,6 +44,8 @@ pub struct FrameView<'a> {
     pub report: &'a OrderingReport,
     /// The cloud file's layout and what decided it.
     pub layout: (crate::recording::InputLayout, crate::recording::LayoutBasis),
+    /// Where the frame came from (its sequence and `.bin`, the layout it was read in).
+    pub provenance: &'a Provenance,
     /// The method.
     pub method: &'a str,
     /// Its decisions per cell of `cloud`.
@@ -50,9 +54,11 @@ pub struct FrameView<'a> {
     pub score: &'a FrameScore,
 }
 
-/// Scores `methods` on every frame of `layout`. `make` builds a method by name, afresh for each
-/// sequence (methods that keep state across frames, such as the grid map, start over); `on_frame`
-/// sees each classified frame. Returns one [`MethodScore`] per method, in the order given.
+/// Scores `methods` on every frame of `layout`, each sequence's first frames read as a recording
+/// of their own ([`DatasetLayout::part`], [`Recording::from_dataset`]). `make` builds a method by
+/// name, afresh for each sequence (methods that keep state across frames, such as the grid map,
+/// start over); `on_frame` sees each classified frame. Returns one [`MethodScore`] per method, in
+/// the order given.
 ///
 /// ```
 /// use classifier::dataset::{evaluate, DatasetLayout, EvalOptions, Protocol};
@@ -95,45 +101,45 @@ pub fn evaluate(
 ) -> Result<Vec<MethodScore>, DatasetError> {
     let mut scores: Vec<MethodScore> =
         methods.iter().map(|m| MethodScore { method: m.clone(), frames: Vec::new() }).collect();
-    let (mut buffer, mut report) = (CloudBuffer::default(), OrderingReport::default());
     let classify_error = |frame: &LabelledFrame| {
         let path = frame.bin.clone();
         move |source| DatasetError::Classify { path, source }
     };
-    for sequence in &layout.sequences {
+    for (k, sequence) in layout.sequences.iter().enumerate() {
         let mut built = Vec::with_capacity(methods.len());
         for m in methods {
             built.push(make(m).map_err(|source| DatasetError::Classify { path: sequence.dir.clone(), source })?);
         }
         let take = options.max_frames_per_sequence.unwrap_or(usize::MAX);
         let setup = options.sequence_setups.and_then(|m| m.get(&sequence.id)).unwrap_or(options.setup);
-        for (index, frame) in sequence.frames.iter().take(take).enumerate() {
-            let FramePoints { records, rings, classes, layout } = frame.read_points(options.layout)?;
-            match &rings {
-                // A nuScenes sweep: ordered from its rings, as `classify` orders it.
-                Some(rings) => {
-                    let attributes =
-                        PointAttributes { intensity: None, labels: Some(&classes), time_s: None, rings: Some(rings) };
-                    setup.order_flat(&records, &attributes, &mut buffer, &mut report)
-                }
-                None => setup.order_kitti(&records, Some(&classes), &mut buffer, &mut report),
-            }
-            .map_err(classify_error(frame))?;
-            let cloud = buffer.cloud();
+        let recording = Recording::from_dataset(layout.part(k, 0..take)).with_layout(options.layout)?;
+        let mut frames = recording.frames(Ordering::Ordered(setup))?;
+        while let Some(read) = frames.next_frame() {
+            let read = read?;
+            let (Some(labelled), Some(report)) = (read.labelled, read.report) else {
+                return Err(DatasetError::Invalid {
+                    flag: "--input",
+                    value: read.provenance.to_string(),
+                    allowed: "a labelled dataset's frame, ordered".to_string(),
+                });
+            };
+            let (frame, index) = (labelled.frame, labelled.index_in_sequence);
+            let (records, classes) = (&labelled.points.records, &labelled.points.classes);
+            let cloud = read.cloud;
             for (method, score) in built.iter_mut().zip(scores.iter_mut()) {
                 let t = Instant::now();
                 let ground = method
                     .classify(&FrameInput { index, cloud, world_from_vehicle: None })
                     .map_err(classify_error(frame))?;
                 let classify_ms = t.elapsed().as_secs_f64() * 1e3;
-                let per_point = decisions_per_point(&report, &ground);
+                let per_point = read.decisions_per_point(&ground);
                 let mut fs = FrameScore {
                     sequence: frame.sequence.clone(),
                     frame: frame.stem.clone(),
                     classify_ms,
                     ..FrameScore::default()
                 };
-                for ((rec, &class), &decision) in records.iter().zip(&classes).zip(&per_point) {
+                for ((rec, &class), &decision) in records.iter().zip(classes).zip(&per_point) {
                     let p = glam::Vec3::new(rec[0], rec[1], rec[2]);
                     if p == glam::Vec3::ZERO || !p.is_finite() {
                         fs.no_returns += 1;
@@ -144,8 +150,9 @@ pub fn evaluate(
                 on_frame(&FrameView {
                     frame,
                     cloud,
-                    report: &report,
-                    layout,
+                    report,
+                    layout: labelled.points.layout,
+                    provenance: read.provenance,
                     method: &score.method,
                     ground: &ground,
                     score: &fs,

@@ -104,7 +104,7 @@ impl DatasetLayout {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn open(dir: &Path, only: Option<&[String]>) -> Result<Self, DatasetError> {
-        if dir.join("lidar").is_dir() && dir.join("lidarseg").is_dir() {
+        if Self::is_lidarseg(dir) {
             return Self::open_lidarseg(dir, only);
         }
         let io = |path: &Path| {
@@ -170,6 +170,18 @@ impl DatasetLayout {
         Ok(Self { root: dir.to_path_buf(), sequences, format: FrameFormat::SemanticKitti })
     }
 
+    /// Whether `dir` has the folders of a labelled dataset: `sequences/` (a dataset root),
+    /// `velodyne/` (one sequence's folder) or `lidar/` with `lidarseg/` (a nuScenes-lidarseg
+    /// folder). [`DatasetLayout::open`] says what is wrong with one that holds no frames.
+    pub fn is_dataset(dir: &Path) -> bool {
+        dir.join("sequences").is_dir() || dir.join("velodyne").is_dir() || Self::is_lidarseg(dir)
+    }
+
+    /// Whether `dir` is a nuScenes-lidarseg folder: `lidar/` with `lidarseg/`.
+    fn is_lidarseg(dir: &Path) -> bool {
+        dir.join("lidar").is_dir() && dir.join("lidarseg").is_dir()
+    }
+
     /// A nuScenes-lidarseg folder (module docs): `lidar/NAME.pcd.bin` with
     /// `lidarseg/NAME_lidarseg.bin`, one sequence named after the folder. Refused: a sweep without
     /// its labels, no sweeps, `only` naming another sequence.
@@ -209,6 +221,23 @@ impl DatasetLayout {
     /// Every frame, sequence by sequence.
     pub fn frames(&self) -> impl Iterator<Item = &LabelledFrame> {
         self.sequences.iter().flat_map(|s| s.frames.iter())
+    }
+
+    /// The same dataset holding only the frames `frames` (by place, clamped to the sequence's) of
+    /// its sequence number `sequence` (none where there is no such sequence): a sequence's first
+    /// frames, or one frame, to be read as a recording of their own.
+    pub fn part(&self, sequence: usize, frames: std::ops::Range<usize>) -> Self {
+        let sequences = self
+            .sequences
+            .get(sequence)
+            .map(|s| {
+                let end = frames.end.min(s.frames.len());
+                let frames = s.frames.get(frames.start.min(end)..end).unwrap_or_default().to_vec();
+                Sequence { id: s.id.clone(), dir: s.dir.clone(), frames }
+            })
+            .into_iter()
+            .collect();
+        Self { root: self.root.clone(), sequences, format: self.format }
     }
 }
 

@@ -3,12 +3,15 @@
 //! classification methods on them under a named protocol.
 //!
 //! - [`layout`]: which sequences and frames a directory holds (`DIR/sequences/NN/{velodyne,labels}`
-//!   or one sequence's `velodyne/` and `labels/`), and reading a frame's `.bin` and `.label`;
+//!   or one sequence's `velodyne/` and `labels/`, or a nuScenes-lidarseg folder), and decoding a
+//!   frame's `.bin` and `.label` in file order;
 //! - [`protocol`]: what counts as ground, what is ignored (`semantickitti`, `patchworkpp`,
 //!   `patchwork`);
 //! - [`score`]: per-point confusion counts per frame and pooled, with range bands;
-//! - [`evaluate`]: every frame read and ordered through the real-recordings path once, each
-//!   method run on it, each decision scored in the file's own point order;
+//! - [`evaluate`]: every frame read and ordered once through [`crate::recording::Recording`] (the
+//!   one reader of recordings: a dataset is a recording, [`crate::recording::Recording::open`]
+//!   recognises its folders, [`crate::recording::FrameReader::read_labelled`] reads and orders a
+//!   labelled frame), each method run on it, each decision scored in the file's own point order;
 //! - [`ours`]: a dataset `groundtruth dataset` wrote orders each sequence with its own rig.
 //!
 //! Frames are read as a user's recording is ([`crate::ordering::SensorSetup::order_kitti`]): scan

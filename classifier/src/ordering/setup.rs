@@ -120,7 +120,9 @@ impl SensorSetup {
         if self.recover {
             return match attributes.rings {
                 None => super::recover::order_recovered(points, attributes, self.vehicle_from_sensor, cloud, report),
-                Some(_) => super::recover::order_ring_field(points, attributes, self.vehicle_from_sensor, cloud, report),
+                Some(_) => {
+                    super::recover::order_ring_field(points, attributes, self.vehicle_from_sensor, cloud, report)
+                }
             };
         }
         order_cloud_into(

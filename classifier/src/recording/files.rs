@@ -17,6 +17,10 @@
 //!   one).
 //! - A bag's PointCloud2 message: decoded by the PCD reader straight from the message's data
 //!   ([`sim::io::ros2::pointcloud2::frame`]) and ordered as a PCD file is.
+//! - A labelled dataset's frame (a SemanticKITTI `.bin` with its `.label`, a nuScenes sweep with
+//!   its lidarseg labels: [`crate::dataset::DatasetLayout`]): read in file order with its classes
+//!   ([`LabelledFrame::read_points`]) and ordered as a `.bin` is, its classes carried through
+//!   ordering as the cloud's labels ([`FrameReader::read_labelled`]).
 
 use std::path::Path;
 use std::time::Instant;
@@ -28,6 +32,7 @@ use sim::io::ros2::BagCloud;
 
 use super::bytes::InputBytes;
 use super::{InputLayout, LayoutBasis, LayoutChoice, Provenance, RecordingError};
+use crate::dataset::{DatasetError, FramePoints, LabelledFrame};
 use crate::ordering::{CloudBuffer, OrderingReport, PointAttributes, SensorSetup, read_organized_into};
 
 /// Reads and orders frames one after another, keeping its buffers (the file's bytes, its points,
@@ -60,6 +65,8 @@ pub struct FrameReader {
     report: OrderingReport,
     /// Whether `report` belongs to the last frame (input from other tools).
     ordered: bool,
+    /// The last labelled frame's points, classes and rings in file order.
+    labelled: Option<FramePoints>,
 }
 
 impl FrameReader {
@@ -72,6 +79,12 @@ impl FrameReader {
     /// point); `None` for our own files and for frames read as stored.
     pub fn report(&self) -> Option<&OrderingReport> {
         self.ordered.then_some(&self.report)
+    }
+
+    /// The last frame's points in file order with their classes, for a labelled dataset's frame
+    /// ([`FrameReader::read_labelled`]); `None` for other frames.
+    pub fn labelled_points(&self) -> Option<&FramePoints> {
+        self.labelled.as_ref()
     }
 
     /// Reads headerless `.bin` files in `choice` (`--layout`) rather than by name and content.
@@ -100,14 +113,21 @@ impl FrameReader {
         self.ordered = false;
     }
 
-    /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
-    /// ordering; for a driver's organized PCD, decoded in order, only the file's read and the header).
-    pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> Result<f64, RecordingError> {
-        let t0 = Instant::now();
+    /// Forgets what the last frame said (its report, layout, NaN count, density, labelled points)
+    /// before the next is read.
+    fn forget_last_frame(&mut self) {
         self.ordered = false;
         self.nan_no_returns = 0;
         self.declared_dense = false;
         self.decided = None;
+        self.labelled = None;
+    }
+
+    /// Reads `path` and orders it; returns the milliseconds spent reading the file (the rest is
+    /// ordering; for a driver's organized PCD, decoded in order, only the file's read and the header).
+    pub fn read(&mut self, path: &Path, setup: &SensorSetup) -> Result<f64, RecordingError> {
+        let t0 = Instant::now();
+        self.forget_last_frame();
         let by_name = InputLayout::of_file(path)?;
         if by_name.is_raw() {
             return self.read_raw(path, setup, t0);
@@ -194,9 +214,7 @@ impl FrameReader {
         setup: Option<&SensorSetup>,
     ) -> Result<f64, RecordingError> {
         let t0 = Instant::now();
-        self.ordered = false;
-        self.nan_no_returns = 0;
-        self.decided = None;
+        self.forget_last_frame();
         let bad = |reason: String| RecordingError::Message {
             bag: provenance.file.clone(),
             topic: provenance.topic.clone().unwrap_or_default(),
@@ -219,6 +237,67 @@ impl FrameReader {
         self.nan_no_returns = read.nan_no_returns;
         Ok(read.read_ms)
     }
+
+    /// Reads the labelled frame `frame` in file order with its classes (SemanticKITTI ids) and, for
+    /// nuScenes records, its rings ([`LabelledFrame::read_points`]: a SemanticKITTI `.bin` in the
+    /// layout `--layout` names, else the one its name and bytes give) and orders it with `setup`:
+    /// KITTI records where they lie ([`SensorSetup::order_kitti`]), nuScenes records from their
+    /// rings ([`SensorSetup::order_flat`]), the classes carried through ordering as the cloud's
+    /// labels; `None` keeps it as stored (`1 x N` in file order, [`stored_cloud`]). The points stay
+    /// at [`FrameReader::labelled_points`]. Returns the milliseconds of the read (the rest is
+    /// ordering). Refused, as [`RecordingError::Dataset`]: what the read refuses; a frame ordering
+    /// refuses ([`DatasetError::Classify`], naming the `.bin`).
+    pub fn read_labelled(&mut self, frame: &LabelledFrame, setup: Option<&SensorSetup>) -> Result<f64, RecordingError> {
+        let t0 = Instant::now();
+        self.forget_last_frame();
+        let points = frame.read_points(self.choice).map_err(Box::new)?;
+        let read_ms = t0.elapsed().as_secs_f64() * 1e3;
+        self.decided = Some(points.layout);
+        match setup {
+            Some(setup) => {
+                let FramePoints { records, rings, classes, .. } = &points;
+                let FrameReader { cloud, report, .. } = self;
+                match rings {
+                    // A nuScenes sweep: ordered from its rings, as `classify` orders it.
+                    Some(rings) => {
+                        let attributes = PointAttributes {
+                            intensity: None,
+                            labels: Some(classes),
+                            time_s: None,
+                            rings: Some(rings),
+                        };
+                        setup.order_flat(records, &attributes, cloud, report)
+                    }
+                    None => setup.order_kitti(records, Some(classes), cloud, report),
+                }
+                .map_err(|source| Box::new(DatasetError::Classify { path: frame.bin.clone(), source }))?;
+                self.ordered = true;
+            }
+            None => self.set_cloud(stored_cloud(&points)),
+        }
+        self.labelled = Some(points);
+        Ok(read_ms)
+    }
+}
+
+/// A labelled frame's points as stored: a `1 x N` grid in file order (no-returns and non-finite
+/// points as NaN), with their intensity, classes (ground where the class is) and rings where the
+/// records have them.
+pub fn stored_cloud(points: &FramePoints) -> OrderedCloud {
+    let mut cloud = OrderedCloud::empty(1, points.records.len(), 1);
+    for (i, (rec, &class)) in points.records.iter().zip(&points.classes).enumerate() {
+        let p = glam::Vec3::new(rec[0], rec[1], rec[2]);
+        let hit = p.is_finite();
+        cloud.point_in_vehicle[i] = if hit { p } else { glam::Vec3::NAN };
+        cloud.range_m[i] = if hit { p.length() } else { f32::NAN };
+        cloud.intensity[i] = rec[3];
+        cloud.ring[i] = points.rings.as_ref().map_or(0, |r| r[i]);
+        cloud.column[i] = i as u32;
+        cloud.sensor[i] = 0;
+        cloud.label[i] = class;
+        cloud.ground[i] = hit && class.is_ground();
+    }
+    cloud
 }
 
 /// Reads `path` as the file holds it, unordered: an organized PCD keeps its grid (`HEIGHT x WIDTH`,

@@ -1,14 +1,22 @@
 //! Recordings read as ordered frames: any input the project reads (a KITTI-layout `.bin`, a PCD,
 //! PLY or LAS file, a directory of them, a scan directory with its `manifest.json`, a ROS 2 bag's
-//! PointCloud2 topic) becomes a sequence of frames, each with its cloud (ordered into rings and
-//! columns by a [`SensorSetup`], or as stored), what ordering did ([`OrderingReport`]) and where it
-//! came from ([`Provenance`]). `classify`, `eval --dataset` (bags), `bench classify` and the Python
-//! package read through here; SemanticKITTI-layout datasets are listed by
-//! [`crate::dataset::DatasetLayout`] and their frames ordered by the same [`SensorSetup`].
+//! PointCloud2 topic, a labelled SemanticKITTI-layout or nuScenes-lidarseg directory) becomes a
+//! sequence of frames, each with its cloud (ordered into rings and columns by a [`SensorSetup`],
+//! or as stored), what ordering did ([`OrderingReport`]) and where it came from ([`Provenance`]).
+//! `classify`, `eval dataset` (datasets and bags, through [`crate::dataset::evaluate`]), `bench
+//! classify`, `train --dataset` and the Python package read through here.
+//!
+//! A directory holding `sequences/` (a SemanticKITTI-layout root), `velodyne/` (one sequence's
+//! folder, `labels/` beside it) or `lidar/` with `lidarseg/` (a nuScenes-lidarseg folder) is a
+//! labelled dataset: listed by [`crate::dataset::DatasetLayout`], its frames read sequence by
+//! sequence, each ordered by the same [`SensorSetup`] with its classes carried through ordering as
+//! the cloud's labels, its points and classes in file order at [`Frame::labelled`], its provenance
+//! naming the sequence and the `.bin`.
 //!
 //! - [`input`]: what a path holds (one file, a scan directory, a directory of files) and each
 //!   file's layout ([`InputLayout`], decided once per file: the place a new layout goes);
-//! - [`files`]: the one reader of the file formats ([`FrameReader`]);
+//! - [`labelled`]: a labelled dataset as a recording ([`LabelledPoints`]);
+//! - [`files`]: the one reader of the file formats and of labelled frames ([`FrameReader`]);
 //! - [`bag`]: a bag's topic (the one there is, or the one named) and the warning of a bag cut short;
 //!   its messages are read in [`Frames`], the one loop over a bag's messages;
 //! - [`provenance`]: where a frame came from;
@@ -34,6 +42,7 @@ pub mod bag;
 pub mod bytes;
 pub mod files;
 pub mod input;
+pub mod labelled;
 pub mod provenance;
 
 use std::path::{Path, PathBuf};
@@ -46,10 +55,13 @@ pub use bag::resolve_topic;
 pub use bytes::InputBytes;
 pub use files::{FrameReader, read_as_stored, read_as_stored_as};
 pub use input::{InputFile, InputLayout, LayoutBasis, LayoutChoice, list_files};
+pub use labelled::LabelledPoints;
 pub use provenance::Provenance;
 
+use crate::dataset::{DatasetError, DatasetLayout};
 use crate::error::ClassifyError;
 use crate::ordering::{OrderingReport, SensorSetup, decisions_per_point};
+use labelled::DatasetSource;
 
 /// Why a recording, or one of its frames, could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -57,6 +69,10 @@ pub enum RecordingError {
     /// A file that could not be read (the error names it).
     #[error(transparent)]
     File(#[from] sim::SimError),
+    /// A labelled dataset that could not be listed, or one of its frames read or ordered (the
+    /// error names the folder or file).
+    #[error(transparent)]
+    Dataset(#[from] Box<DatasetError>),
     /// A path that is neither a file nor a directory.
     #[error("input `{}` is neither a file nor a directory", .path.display())]
     NotFound {
@@ -208,7 +224,8 @@ pub enum Ordering<'a> {
     AsStored,
 }
 
-/// A recording: a file, a directory of files, a scan directory, or a bag's topic.
+/// A recording: a file, a directory of files, a scan directory, a bag's topic, or a labelled
+/// dataset.
 #[derive(Debug)]
 pub struct Recording {
     path: PathBuf,
@@ -220,12 +237,16 @@ pub struct Recording {
 enum Source {
     Files(Vec<InputFile>),
     Bag { bag: Bag, topic: String },
+    Dataset(DatasetSource),
 }
 
 impl Recording {
     /// Opens `path`: a bag (an `.mcap` file or a rosbag2 directory; `topic`, or its one PointCloud2
-    /// topic), else the files of [`list_files`]. Refused: a topic for an input that is not a bag,
-    /// and what [`list_files`] and [`resolve_topic`] refuse.
+    /// topic); a labelled dataset, every sequence (a directory holding `sequences/`, `velodyne/`,
+    /// or `lidar/` with `lidarseg/`: [`DatasetLayout::is_dataset`], listed by
+    /// [`DatasetLayout::open`]); else the files of [`list_files`]. Refused: a topic for an input
+    /// that is not a bag, and what [`list_files`], [`DatasetLayout::open`] and [`resolve_topic`]
+    /// refuse.
     pub fn open(path: &Path, topic: Option<&str>) -> Result<Self, RecordingError> {
         if sim::io::ros2::is_bag(path) {
             let bag = Bag::open(path)?;
@@ -235,20 +256,43 @@ impl Recording {
         if topic.is_some() {
             return Err(RecordingError::TopicWithoutBag { path: path.to_path_buf() });
         }
+        if path.is_dir() && DatasetLayout::is_dataset(path) {
+            return Ok(Self::from_dataset(DatasetLayout::open(path, None).map_err(Box::new)?));
+        }
         Ok(Self { path: path.to_path_buf(), source: Source::Files(list_files(path)?), layout: None })
+    }
+
+    /// The recording of a labelled dataset as listed (its root the path; some sequences, or some
+    /// frames of one, with [`DatasetLayout::open`]'s `only` and [`DatasetLayout::part`]).
+    pub fn from_dataset(layout: DatasetLayout) -> Self {
+        Self { path: layout.root.clone(), source: Source::Dataset(DatasetSource::new(layout)), layout: None }
+    }
+
+    /// The listing, for a labelled dataset.
+    pub fn dataset(&self) -> Option<&DatasetLayout> {
+        match &self.source {
+            Source::Dataset(d) => Some(&d.layout),
+            _ => None,
+        }
     }
 
     /// The same recording with its headerless `.bin` files read in `layout` (`--layout`: KITTI or
     /// nuScenes records, whatever their names and contents say); `None` decides per file
-    /// ([`InputLayout::decide`]). Refused: a layout for a bag, a layout for a file that is not a
+    /// ([`InputLayout::decide`]). Refused: a layout for a bag, KITTI records for a
+    /// nuScenes-lidarseg folder (its sweeps are nuScenes records), a layout for a file that is not a
     /// `.bin` (when its frame is read).
     pub fn with_layout(mut self, layout: Option<LayoutChoice>) -> Result<Self, RecordingError> {
-        if let (Some(choice), Source::Bag { .. }) = (layout, &self.source) {
-            return Err(RecordingError::LayoutOfNonRaw {
-                path: self.path.clone(),
-                choice,
-                named: InputLayout::PointCloud2,
-            });
+        let named = match (layout, &self.source) {
+            (Some(_), Source::Bag { .. }) => Some(InputLayout::PointCloud2),
+            (Some(LayoutChoice::Kitti), Source::Dataset(d))
+                if d.layout.format == crate::dataset::FrameFormat::NuscenesLidarseg =>
+            {
+                Some(InputLayout::NuscenesBin)
+            }
+            _ => None,
+        };
+        if let (Some(choice), Some(named)) = (layout, named) {
+            return Err(RecordingError::LayoutOfNonRaw { path: self.path.clone(), choice, named });
         }
         self.layout = layout;
         Ok(self)
@@ -268,14 +312,16 @@ impl Recording {
     pub fn topic(&self) -> Option<&str> {
         match &self.source {
             Source::Bag { topic, .. } => Some(topic),
-            Source::Files(_) => None,
+            Source::Files(_) | Source::Dataset(_) => None,
         }
     }
 
-    /// The files, for a recording of files (empty for a bag).
+    /// The files, for a recording of files (for a labelled dataset its frames' cloud files, in
+    /// the order they are read, indexed by place; empty for a bag).
     pub fn files(&self) -> &[InputFile] {
         match &self.source {
             Source::Files(files) => files,
+            Source::Dataset(d) => &d.files,
             Source::Bag { .. } => &[],
         }
     }
@@ -284,7 +330,7 @@ impl Recording {
     pub fn frames<'r>(&'r self, ordering: Ordering<'r>) -> Result<Frames<'r>, RecordingError> {
         let clouds = match &self.source {
             Source::Bag { bag, topic } => Some(bag.clouds(topic)?),
-            Source::Files(_) => None,
+            Source::Files(_) | Source::Dataset(_) => None,
         };
         let mut reader = FrameReader::default();
         reader.set_layout_choice(self.layout);
@@ -307,7 +353,8 @@ impl Recording {
 /// One frame of a recording, borrowed from its [`Frames`] until the next is read.
 pub struct Frame<'a> {
     /// Frame index: a file's (manifest, `frame_NNNNNN` name, place in the directory), a message's
-    /// index on its topic.
+    /// index on its topic, a labelled dataset's frame's place in the recording (sequence by
+    /// sequence; its place in its sequence is [`LabelledPoints::index_in_sequence`]).
     pub index: usize,
     /// The cloud.
     pub cloud: &'a OrderedCloud,
@@ -323,6 +370,10 @@ pub struct Frame<'a> {
     pub read_ms: f64,
     /// The bag's message, for a message (to write it back with decisions, say).
     pub message: Option<&'a BagCloud>,
+    /// A labelled dataset's frame: its files, its place in its sequence, its points and classes
+    /// in file order (the classes are also the cloud's labels, carried through ordering); `None`
+    /// for other recordings.
+    pub labelled: Option<LabelledPoints<'a>>,
 }
 
 impl Frame<'_> {
@@ -390,26 +441,31 @@ impl Frames<'_> {
                 read
             }
             None => {
-                let file = self.recording.files().get(self.next_file)?;
+                let recording = self.recording;
+                let file = recording.files().get(self.next_file)?;
                 self.next_file += 1;
                 self.message = None;
                 self.world_from_vehicle = file.world_from_vehicle;
-                let read = match self.ordering {
-                    Ordering::Ordered(setup) => {
-                        self.reader.read(&file.path, setup).map(|ms| (ms, self.reader.layout()))
-                    }
-                    Ordering::AsStored => {
-                        let t0 = std::time::Instant::now();
-                        read_as_stored_as(&file.path, self.recording.layout).map(|(cloud, layout)| {
-                            self.reader.set_cloud(cloud);
-                            (t0.elapsed().as_secs_f64() * 1e3, layout)
-                        })
-                    }
-                };
-                read.map(|(ms, (layout, basis))| {
-                    self.provenance = Provenance::file(file.path.clone(), layout, basis);
-                    ms
-                })
+                if let Source::Dataset(dataset) = &recording.source {
+                    self.read_labelled(dataset, self.next_file - 1)?
+                } else {
+                    let read = match self.ordering {
+                        Ordering::Ordered(setup) => {
+                            self.reader.read(&file.path, setup).map(|ms| (ms, self.reader.layout()))
+                        }
+                        Ordering::AsStored => {
+                            let t0 = std::time::Instant::now();
+                            read_as_stored_as(&file.path, self.recording.layout).map(|(cloud, layout)| {
+                                self.reader.set_cloud(cloud);
+                                (t0.elapsed().as_secs_f64() * 1e3, layout)
+                            })
+                        }
+                    };
+                    read.map(|(ms, (layout, basis))| {
+                        self.provenance = Provenance::file(file.path.clone(), layout, basis);
+                        ms
+                    })
+                }
             }
         };
         let read_ms = match read_ms {
@@ -421,6 +477,10 @@ impl Frames<'_> {
             (None, Some(f)) => f.index,
             (None, None) => 0,
         };
+        let labelled = match &self.recording.source {
+            Source::Dataset(dataset) => self.labelled(dataset),
+            _ => None,
+        };
         Some(Ok(Frame {
             index,
             cloud: self.reader.cloud(),
@@ -429,6 +489,7 @@ impl Frames<'_> {
             world_from_vehicle: self.world_from_vehicle,
             read_ms,
             message: self.message.as_ref(),
+            labelled,
         }))
     }
 

@@ -1,5 +1,5 @@
-//! Where a frame came from: its file, and for a bag's message its topic, index and log time; the
-//! layout its points were read in. With the ordering report ([`crate::ordering::OrderingReport`])
+//! Where a frame came from: its file, and for a bag's message its topic, index and log time, for a
+//! labelled dataset's frame its sequence; the layout its points were read in. With the ordering report ([`crate::ordering::OrderingReport`])
 //! it says how a frame was read.
 
 use std::path::PathBuf;
@@ -23,12 +23,20 @@ pub struct Provenance {
     pub message: Option<usize>,
     /// The message's log time, nanoseconds, for a message.
     pub log_time_ns: Option<u64>,
+    /// The sequence (its folder name, e.g. `08`), for a labelled dataset's frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sequence: Option<String>,
 }
 
 impl Provenance {
     /// A file's.
     pub fn file(file: PathBuf, layout: InputLayout, layout_by: LayoutBasis) -> Self {
-        Self { file, layout, layout_by, topic: None, message: None, log_time_ns: None }
+        Self { file, layout, layout_by, topic: None, message: None, log_time_ns: None, sequence: None }
+    }
+
+    /// A labelled dataset's frame's: its cloud file `file` in sequence `sequence`.
+    pub fn sequence_file(file: PathBuf, sequence: &str, layout: InputLayout, layout_by: LayoutBasis) -> Self {
+        Self { sequence: Some(sequence.to_string()), ..Self::file(file, layout, layout_by) }
     }
 
     /// A bag message's.
@@ -40,6 +48,7 @@ impl Provenance {
             topic: Some(topic.to_string()),
             message: Some(index),
             log_time_ns: Some(log_time_ns),
+            sequence: None,
         }
     }
 

@@ -91,9 +91,11 @@ impl Backend {
                 Err(e) => Err(crate::error::SimError::invalid("backend", "gpu", e.to_string())),
             },
             #[cfg(not(feature = "gpu"))]
-            Backend::Gpu => {
-                Err(crate::error::SimError::invalid("backend", "gpu", format!("bvh or parry: the GPU backend is {GPU_NOT_BUILT}")))
-            }
+            Backend::Gpu => Err(crate::error::SimError::invalid(
+                "backend",
+                "gpu",
+                format!("bvh or parry: the GPU backend is {GPU_NOT_BUILT}"),
+            )),
         }
     }
 }

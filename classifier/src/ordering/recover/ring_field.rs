@@ -97,8 +97,11 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     }
     let largest = span(fullest[0]).len();
     let cols_estimate = super::median(&mut gaps);
-    let cols_estimate =
-        if cols_estimate.is_finite() && cols_estimate > 0.0 { ((TAU / cols_estimate).round() as usize).clamp(2, 1 << 16) } else { largest.max(2) };
+    let cols_estimate = if cols_estimate.is_finite() && cols_estimate > 0.0 {
+        ((TAU / cols_estimate).round() as usize).clamp(2, 1 << 16)
+    } else {
+        largest.max(2)
+    };
     let matched = matching::match_rings(&tan_sorted, &dist_sorted);
     let (table, columns, row_of_sorted) = match &matched {
         Some(m) => {
