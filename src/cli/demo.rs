@@ -113,7 +113,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         let s = eval.pooled.scores();
         table.push((name.clone(), s, eval.pooled.total()));
-        scores.insert(name.clone(), serde_json::to_value(&s)?);
+        scores.insert(name.clone(), serde_json::to_value(s)?);
     }
     println!("2. classified with {} -> {}/<method>/", args.methods.join(", "), class_dir.display());
     println!("3. scores against the ground truth ({} points):", table.first().map_or(0, |t| t.2));

@@ -149,8 +149,8 @@ fn align_rows(medians: &[f32], dist_m: &[f32], rows: &TableRows) -> Option<Vec<u
     // cost[i * r + j]: rings 0..=i aligned, ring i to row j; from[i * r + j]: ring i - 1's row.
     let mut cost = vec![f32::INFINITY; k * r];
     let mut from = vec![0usize; k * r];
-    for j in 0..=(r - k) {
-        cost[j] = err(0, j);
+    for (j, c) in cost.iter_mut().enumerate().take(r - k + 1) {
+        *c = err(0, j);
     }
     for i in 1..k {
         let mut run = (f32::INFINITY, 0usize);
