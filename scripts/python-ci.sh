@@ -33,8 +33,13 @@ log "pip install maturin numpy pytest pypatchworkpp mypy, and the ROS 2 bag clie
 "$py" -m pip install -q "maturin>=1.9,<2" numpy pytest "pypatchworkpp==1.4.1" mypy \
   "mcap==1.6.0" "mcap-ros2-support==0.6.0" "rosbags==0.11.9" "rerun-sdk==0.41.0"
 
-log "cargo build --release --bin groundtruth (the CLI of the round-trip tests)"
-cargo build --release --locked --bin groundtruth
+# GROUNDTRUTH_BIN: the CLI of the round-trip tests (CI passes the test build's
+# target/debug/groundtruth); default: the release build.
+if [ -z "${GROUNDTRUTH_BIN:-}" ]; then
+  log "cargo build --release --bin groundtruth (the CLI of the round-trip tests)"
+  cargo build --release --locked --bin groundtruth
+  GROUNDTRUTH_BIN="$CARGO_TARGET_DIR/release/groundtruth"
+fi
 
 log "pip install ./python (maturin, release)"
 "$py" -m pip install -q --no-build-isolation --force-reinstall --no-deps ./python
@@ -43,7 +48,7 @@ log "mypy.stubtest: the type stubs match the module"
 (cd "$CARGO_TARGET_DIR" && "$py" -m mypy.stubtest groundtruth._native)
 
 log "pytest python/tests examples/python"
-export GROUNDTRUTH_BIN="$CARGO_TARGET_DIR/release/groundtruth" GT_REQUIRE_CLI=1
+export GROUNDTRUTH_BIN GT_REQUIRE_CLI=1
 # From outside the source tree, so the installed package (not python/groundtruth/) is imported.
 (cd "$CARGO_TARGET_DIR" && "$py" -m pytest -q -p no:cacheprovider "$OLDPWD/python/tests" "$OLDPWD/examples/python")
 log "done"

@@ -129,8 +129,11 @@ case $state in
 esac
 
 # 4. The sweep: unsharded, then as a 4-task array, merged.
-bin=$repo/target/release/groundtruth
-[ -x "$bin" ] || cargo build --release
+# GROUNDTRUTH_BIN: a built program (CI passes the test build's target/debug/groundtruth, so no
+# second, optimised build of the whole program); default: the release build, built if missing.
+bin=${GROUNDTRUTH_BIN:-$repo/target/release/groundtruth}
+if [ -z "${GROUNDTRUTH_BIN:-}" ] && [ ! -x "$bin" ]; then cargo build --release --locked --bin groundtruth; fi
+[ -x "$bin" ] || { echo "slurm-local.sh: GROUNDTRUTH_BIN=$bin is not an executable" >&2; exit 2; }
 log "unsharded run of $sweep"
 "$bin" sweep --config "$sweep" --out "$work/whole" 2>/dev/null
 mkdir -p "$work/logs"
