@@ -201,6 +201,8 @@ impl Scanner<'_> {
                     time_s: start_time_s + f.time_s,
                 })
             };
+            // This beam's later echoes are `extra[beam_extra..]`, planes 1, 2, ...
+            let beam_extra = extra.len();
             let first = if sub_rays == 1 {
                 // One ray per beam: at most one echo.
                 hits[b].filter(|_| m.max_echoes > 0).and_then(|h| hit_cell(h, 1, 0))
@@ -224,7 +226,8 @@ impl Scanner<'_> {
                 }
                 first
             };
-            // Weather: the medium attenuates the return and may replace it with its own.
+            // Weather: the medium attenuates the return and may replace it with its own, or (dual
+            // return) put its own in front of it.
             let first = match &self.weather[s] {
                 None => first,
                 Some(w) => {
@@ -235,9 +238,14 @@ impl Scanner<'_> {
                         ring: ring as u32,
                         column: c as u32,
                     };
-                    match w.beam(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key) {
+                    let echoes = w.echoes(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key);
+                    match echoes.first {
                         BeamOutcome::Target { intensity } => first.map(|cell| Cell { intensity, ..cell }),
                         BeamOutcome::Medium { range_m, intensity, class } => {
+                            if let (Some(intensity), Some(cell)) = (echoes.target_behind, first) {
+                                let target = ExtraEcho { row, col: mc, echo: 1, cell: Cell { intensity, ..cell } };
+                                push_behind_medium(&mut extra, beam_extra, target, m.max_echoes);
+                            }
                             let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * range_m;
                             Some(Cell {
                                 point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
@@ -263,6 +271,20 @@ impl Scanner<'_> {
             }
         }
         extra
+    }
+}
+
+/// Dual return with the medium's echo in plane 0: the target's echo `target` (plane 1) goes in
+/// front of the beam's later echoes `extra[from..]`, which move back one plane; those beyond the
+/// sensor's `planes` are dropped (nearest first, at most `planes` echoes).
+fn push_behind_medium(extra: &mut Vec<ExtraEcho>, from: usize, target: ExtraEcho, planes: u8) {
+    extra.insert(from, target);
+    for e in &mut extra[from + 1..] {
+        e.echo += 1;
+    }
+    // The beam's echoes are last in `extra`, their planes ascending.
+    while extra.len() > from && extra.last().is_some_and(|e| e.echo >= planes) {
+        extra.pop();
     }
 }
 
