@@ -340,3 +340,51 @@ pub(super) fn merge_echoes(echoes: &mut Vec<(f32, Hit, u32)>, separation_m: f32)
     }
     *echoes = out;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::SemanticClass;
+
+    fn echo(col: usize, echo: u8, range_m: f32) -> ExtraEcho {
+        let cell = Cell {
+            point_in_vehicle: Vec3::X * range_m,
+            range_m,
+            intensity: 0.5,
+            class: SemanticClass(40),
+            instance: 0,
+            normal: Vec3::NEG_X,
+            sensor: 0,
+            ring: 0,
+            column: col as u32,
+            time_s: 0.0,
+        };
+        ExtraEcho { row: 0, col, echo, cell }
+    }
+
+    fn planes_and_ranges(extra: &[ExtraEcho]) -> Vec<(usize, u8, f32)> {
+        extra.iter().map(|e| (e.col, e.echo, e.cell.range_m)).collect()
+    }
+
+    /// Dual with the medium's echo in plane 0: the surface goes to plane 1 and the beam's later
+    /// echoes move back one plane, those beyond the sensor's planes dropped; other beams' echoes
+    /// stay as they are.
+    #[test]
+    fn the_surface_goes_behind_the_medium_and_later_echoes_move_back() {
+        // Column 3's second echo, then column 4's (the beam in hand) echoes 1 and 2.
+        let beam = || vec![echo(3, 1, 9.0), echo(4, 1, 20.0), echo(4, 2, 30.0)];
+        let surface = echo(4, 1, 12.0);
+        // Three planes (the LUX): surface, then the old planes 1 and 2 as 2 and 3; 3 is dropped.
+        let mut extra = beam();
+        push_behind_medium(&mut extra, 1, surface, 3);
+        assert_eq!(planes_and_ranges(&extra), vec![(3, 1, 9.0), (4, 1, 12.0), (4, 2, 20.0)]);
+        // Two planes (dual): the surface only.
+        let mut extra = beam();
+        push_behind_medium(&mut extra, 1, surface, 2);
+        assert_eq!(planes_and_ranges(&extra), vec![(3, 1, 9.0), (4, 1, 12.0)]);
+        // A beam without later echoes.
+        let mut extra = vec![echo(3, 1, 9.0)];
+        push_behind_medium(&mut extra, 1, surface, 2);
+        assert_eq!(planes_and_ranges(&extra), vec![(3, 1, 9.0), (4, 1, 12.0)]);
+    }
+}
