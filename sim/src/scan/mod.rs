@@ -144,7 +144,8 @@ pub struct Scanner<'a> {
     surfaces: Arc<Vec<Surface>>,
     patterns: Vec<ScanPattern>,
     measurements: Vec<Measurement>,
-    /// Per sensor, the weather's threshold and medium (none without weather or with `ideal`).
+    /// Per sensor, the weather's threshold, medium and return mode (none without weather or with
+    /// `ideal`).
     weather: Vec<Option<crate::effects::weather::SensorWeather>>,
     vehicle_from_sensor: Vec<Affine3A>,
     layout: RigLayout,
@@ -237,10 +238,16 @@ impl<'a> Scanner<'a> {
             .iter()
             .map(|s| if config.ideal { s.spec.measurement().ideal() } else { s.spec.measurement() })
             .collect();
-        let weather = measurements
+        let weather = rig
+            .sensors
             .iter()
-            .map(|m| {
-                config.weather.filter(|_| !config.ideal).map(|w| crate::effects::weather::SensorWeather::new(&w, m))
+            .zip(&measurements)
+            .map(|(sensor, m)| {
+                use crate::effects::weather::{SensorWeather, return_mode_of};
+                config
+                    .weather
+                    .filter(|_| !config.ideal)
+                    .map(|w| SensorWeather::new(&w, m).with_return_mode(return_mode_of(&sensor.spec, m)))
             })
             .collect();
         let vehicle_from_sensor = rig.sensors.iter().map(|s| s.mount.vehicle_from_sensor()).collect();

@@ -201,6 +201,8 @@ impl Scanner<'_> {
                     time_s: start_time_s + f.time_s,
                 })
             };
+            // This beam's later echoes are `extra[beam_extra..]`, planes 1, 2, ...
+            let beam_extra = extra.len();
             let first = if sub_rays == 1 {
                 // One ray per beam: at most one echo.
                 hits[b].filter(|_| m.max_echoes > 0).and_then(|h| hit_cell(h, 1, 0))
@@ -224,7 +226,8 @@ impl Scanner<'_> {
                 }
                 first
             };
-            // Weather: the medium attenuates the return and may replace it with its own.
+            // Weather: the medium attenuates the return and may replace it with its own, or (dual
+            // return) put its own in front of it.
             let first = match &self.weather[s] {
                 None => first,
                 Some(w) => {
@@ -235,9 +238,14 @@ impl Scanner<'_> {
                         ring: ring as u32,
                         column: c as u32,
                     };
-                    match w.beam(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key) {
+                    let echoes = w.echoes(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key);
+                    match echoes.first {
                         BeamOutcome::Target { intensity } => first.map(|cell| Cell { intensity, ..cell }),
                         BeamOutcome::Medium { range_m, intensity, class } => {
+                            if let (Some(intensity), Some(cell)) = (echoes.target_behind, first) {
+                                let target = ExtraEcho { row, col: mc, echo: 1, cell: Cell { intensity, ..cell } };
+                                push_behind_medium(&mut extra, beam_extra, target, m.max_echoes);
+                            }
                             let point_in_sensor = f.origin_in_sensor + f.dir_in_sensor * range_m;
                             Some(Cell {
                                 point_in_vehicle: vehicle_from_sensor.transform_point3(point_in_sensor),
@@ -263,6 +271,20 @@ impl Scanner<'_> {
             }
         }
         extra
+    }
+}
+
+/// Dual return with the medium's echo in plane 0: the target's echo `target` (plane 1) goes in
+/// front of the beam's later echoes `extra[from..]`, which move back one plane; those beyond the
+/// sensor's `planes` are dropped (nearest first, at most `planes` echoes).
+fn push_behind_medium(extra: &mut Vec<ExtraEcho>, from: usize, target: ExtraEcho, planes: u8) {
+    extra.insert(from, target);
+    for e in &mut extra[from + 1..] {
+        e.echo += 1;
+    }
+    // The beam's echoes are last in `extra`, their planes ascending.
+    while extra.len() > from && extra.last().is_some_and(|e| e.echo >= planes) {
+        extra.pop();
     }
 }
 
@@ -317,4 +339,52 @@ pub(super) fn merge_echoes(echoes: &mut Vec<(f32, Hit, u32)>, separation_m: f32)
         }
     }
     *echoes = out;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::SemanticClass;
+
+    fn echo(col: usize, echo: u8, range_m: f32) -> ExtraEcho {
+        let cell = Cell {
+            point_in_vehicle: Vec3::X * range_m,
+            range_m,
+            intensity: 0.5,
+            class: SemanticClass(40),
+            instance: 0,
+            normal: Vec3::NEG_X,
+            sensor: 0,
+            ring: 0,
+            column: col as u32,
+            time_s: 0.0,
+        };
+        ExtraEcho { row: 0, col, echo, cell }
+    }
+
+    fn planes_and_ranges(extra: &[ExtraEcho]) -> Vec<(usize, u8, f32)> {
+        extra.iter().map(|e| (e.col, e.echo, e.cell.range_m)).collect()
+    }
+
+    /// Dual with the medium's echo in plane 0: the surface goes to plane 1 and the beam's later
+    /// echoes move back one plane, those beyond the sensor's planes dropped; other beams' echoes
+    /// stay as they are.
+    #[test]
+    fn the_surface_goes_behind_the_medium_and_later_echoes_move_back() {
+        // Column 3's second echo, then column 4's (the beam in hand) echoes 1 and 2.
+        let beam = || vec![echo(3, 1, 9.0), echo(4, 1, 20.0), echo(4, 2, 30.0)];
+        let surface = echo(4, 1, 12.0);
+        // Three planes (the LUX): surface, then the old planes 1 and 2 as 2 and 3; 3 is dropped.
+        let mut extra = beam();
+        push_behind_medium(&mut extra, 1, surface, 3);
+        assert_eq!(planes_and_ranges(&extra), vec![(3, 1, 9.0), (4, 1, 12.0), (4, 2, 20.0)]);
+        // Two planes (dual): the surface only.
+        let mut extra = beam();
+        push_behind_medium(&mut extra, 1, surface, 2);
+        assert_eq!(planes_and_ranges(&extra), vec![(3, 1, 9.0), (4, 1, 12.0)]);
+        // A beam without later echoes.
+        let mut extra = vec![echo(3, 1, 9.0)];
+        push_behind_medium(&mut extra, 1, surface, 2);
+        assert_eq!(planes_and_ranges(&extra), vec![(3, 1, 9.0), (4, 1, 12.0)]);
+    }
 }

@@ -8,7 +8,8 @@
 //! `P >= P_min`, its detection threshold: `P_min = 0.1 (r_ref / max_range)^2`, a 10 % target at
 //! normal incidence seen out to the sensor's maximum range in clear air. The medium attenuates a
 //! hard target twice (out and back), `T^2 = exp(-2 alpha R)`, and adds returns of its own; the
-//! sensor reports the strongest detectable return of the beam, as single-return units do:
+//! sensor reports the strongest detectable return of the beam, as single-return units do in their
+//! strongest mode (other modes: "Return modes" below):
 //!
 //! - **Fog** (visibility = meteorological optical range `V`, m): extinction `alpha = ln 20 / V`,
 //!   backscatter `beta = 0.046 / V` (1/(m sr)); the fog's own return is the pulse-weighted
@@ -26,7 +27,27 @@
 //! `clear` applies the detection threshold without a medium: the reference a weather scan is
 //! compared with. Returns from the medium get their own classes ([`SemanticClass::FOG`],
 //! [`SemanticClass::RAIN`], [`SemanticClass::SNOW`]); every other return keeps its ground truth,
-//! its intensity reduced by `T^2`. Later echoes of multi-echo sensors are left as they are.
+//! its intensity reduced by `T^2`.
+//!
+//! # Return modes
+//! The medium meets the sensor's return mode ([`ReturnMode`], [`SensorWeather::with_return_mode`];
+//! a catalogued model's `return_mode`, [`return_mode_of`] for the rest). With `T` the beam's
+//! hard target (its first echo) and `M` the medium's candidate return in front of it:
+//! - `Strongest` (the default): `M` is reported instead of `T` when it is detectable and at least
+//!   as strong as `T` (the medium is drawn against the floor `max(P_T, P_min)`), else `T`.
+//! - `Last`: `T` whenever it is detectable (a particle in front never hides it; nothing is drawn);
+//!   `M` (drawn against `P_min`) only when there is no detectable target.
+//! - `Dual` (two echo planes, nearest first; also every multi-echo model without catalogued modes,
+//!   such as the LUX, whose planes are every echo nearest first): `M` whenever it is detectable
+//!   (drawn against `P_min`, however strong `T` is) in plane 0, then `T` in plane 1 when it is
+//!   detectable; that is both the strongest-and-last pair of Velodyne and Hesai and Ouster's two
+//!   strongest when the beam holds these two returns. The beam's later surface echoes (edges) move
+//!   back one plane behind `T`, and those beyond the sensor's planes are dropped
+//!   (`crate::scan`).
+//!
+//! The medium's return is its strongest particle (or the fog's backscatter peak) in every mode;
+//! a real `Last` or `Dual` unit would report the last of several detectable particles, but a
+//! beam rarely holds more than one. Later surface echoes are left as they are (not attenuated).
 
 pub mod fog;
 pub mod particles;
@@ -39,7 +60,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, SimError};
 use crate::noise::{BeamKey, Purpose};
 use crate::scene::SemanticClass;
-use crate::sensor::Measurement;
+use crate::sensor::{Measurement, ReturnMode, SensorSpec};
 
 /// The largest snowfall rate accepted, mm/h of water: the calibrated range (docs/weather.md). A
 /// larger rate is refused, naming this range.
@@ -201,6 +222,29 @@ pub enum BeamOutcome {
     Lost,
 }
 
+/// What the weather makes of one beam in the sensor's return mode: the nearest echo it reports
+/// and, in [`ReturnMode::Dual`] when that echo is the medium's, the target's echo behind it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeamEchoes {
+    /// The nearest reported echo (the only one in `Strongest` and `Last`).
+    pub first: BeamOutcome,
+    /// `Dual` only, when [`BeamEchoes::first`] is the medium's: the intensity of the target's
+    /// echo behind it (reduced by the medium), or `None` when the target is not detectable.
+    pub target_behind: Option<f32>,
+}
+
+/// The return mode in which the weather meets the sensor `spec` measuring with `m`: a catalogued
+/// model's `return_mode`; [`ReturnMode::Dual`] (every echo, nearest first) for the other models
+/// when they report several echoes (`m.max_echoes > 1`: the LUX's three), else
+/// [`ReturnMode::Strongest`].
+pub fn return_mode_of(spec: &SensorSpec, m: &Measurement) -> ReturnMode {
+    match spec.catalogued() {
+        Some((_, settings)) => settings.return_mode(),
+        None if m.max_echoes > 1 => ReturnMode::Dual,
+        None => ReturnMode::Strongest,
+    }
+}
+
 /// The medium as one sensor sees it.
 #[derive(Clone, Debug)]
 enum Medium {
@@ -209,14 +253,15 @@ enum Medium {
     Particles(Arc<particles::ParticleTable>),
 }
 
-/// The weather for one sensor: its threshold, the medium's extinction and the tables of its own
-/// returns, built once per scan.
+/// The weather for one sensor: its threshold, the medium's extinction, the tables of its own
+/// returns and the sensor's return mode, built once per scan.
 #[derive(Clone, Debug)]
 pub struct SensorWeather {
     alpha_per_m: f32,
     p_min: f32,
     m: Measurement,
     medium: Medium,
+    mode: ReturnMode,
 }
 
 impl SensorWeather {
@@ -233,7 +278,18 @@ impl SensorWeather {
                 Medium::Particles(Arc::new(particles::ParticleTable::new(&particles::Particles::snow(rate_mm_h), m)))
             }
         };
-        Self { alpha_per_m, p_min: detection_threshold(m), m: *m, medium }
+        Self { alpha_per_m, p_min: detection_threshold(m), m: *m, medium, mode: ReturnMode::Strongest }
+    }
+
+    /// This weather for a sensor reporting in `mode` (module docs; [`SensorWeather::new`] gives
+    /// `Strongest`).
+    pub fn with_return_mode(self, mode: ReturnMode) -> Self {
+        Self { mode, ..self }
+    }
+
+    /// The return mode the weather meets.
+    pub fn return_mode(&self) -> ReturnMode {
+        self.mode
     }
 
     /// The sensor's detection threshold (power units of the module docs).
@@ -246,16 +302,31 @@ impl SensorWeather {
         (-2.0 * self.alpha_per_m * range_m).exp()
     }
 
-    /// Decides a beam: `target` is its clear-weather return, `(range_m, intensity)`, or `None`
-    /// when it returns nothing (the beam then meets the medium out to the maximum range).
+    /// Decides a beam's nearest reported echo: `target` is its clear-weather return, `(range_m,
+    /// intensity)`, or `None` when it returns nothing (the beam then meets the medium out to the
+    /// maximum range). [`SensorWeather::echoes`]`.first`.
     pub fn beam(&self, target: Option<(f32, f32)>, key: &BeamKey) -> BeamOutcome {
+        self.echoes(target, key).first
+    }
+
+    /// Decides a beam in the sensor's return mode (module docs): its nearest reported echo and,
+    /// in `Dual`, the target's echo behind the medium's. `target` as in [`SensorWeather::beam`].
+    pub fn echoes(&self, target: Option<(f32, f32)>, key: &BeamKey) -> BeamEchoes {
         let hard = target.map(|(r, i)| {
             let t2 = self.transmission(r);
             (r, i * t2, unsaturated_power(&self.m, i, r) * t2)
         });
         let hard = hard.filter(|&(_, _, p)| p >= self.p_min);
-        // The medium's return must be detectable and stronger than the target's.
-        let floor = hard.map_or(self.p_min, |(_, _, p)| p.max(self.p_min));
+        let floor = match (self.mode, hard) {
+            // The medium's return must be detectable and stronger than the target's.
+            (ReturnMode::Strongest, _) => hard.map_or(self.p_min, |(_, _, p)| p.max(self.p_min)),
+            // A detectable target is the last return: nothing in front of it is reported.
+            (ReturnMode::Last, Some((_, intensity, _))) => {
+                return BeamEchoes { first: BeamOutcome::Target { intensity }, target_behind: None };
+            }
+            // Detectable is enough: the target does not hide it.
+            (ReturnMode::Last | ReturnMode::Dual, _) => self.p_min,
+        };
         let reach_m = target.map_or(self.m.max_range_m, |(r, _)| r.min(self.m.max_range_m));
         let medium = match &self.medium {
             Medium::None => None,
@@ -267,11 +338,14 @@ impl SensorWeather {
             .map(|(range_m, power, class)| (quantise(range_m, self.m.range_quantum_m), power, class))
             .filter(|&(range_m, _, _)| target.is_none_or(|(r, _)| range_m < r));
         match (medium, hard) {
-            (Some((range_m, power, class)), _) => {
-                BeamOutcome::Medium { range_m, intensity: saturate(&self.m, power, range_m), class }
+            (Some((range_m, power, class)), _) => BeamEchoes {
+                first: BeamOutcome::Medium { range_m, intensity: saturate(&self.m, power, range_m), class },
+                target_behind: hard.filter(|_| self.mode == ReturnMode::Dual).map(|(_, intensity, _)| intensity),
+            },
+            (None, Some((_, intensity, _))) => {
+                BeamEchoes { first: BeamOutcome::Target { intensity }, target_behind: None }
             }
-            (None, Some((_, intensity, _))) => BeamOutcome::Target { intensity },
-            (None, None) => BeamOutcome::Lost,
+            (None, None) => BeamEchoes { first: BeamOutcome::Lost, target_behind: None },
         }
     }
 }
@@ -367,6 +441,91 @@ mod tests {
             assert!(detected(root - 0.05) && !detected(root + 0.05), "rho {rho}: root {root} m");
             // Far below the clear-weather range of the same target (clear: 120 m for rho 0.1).
             assert!(root < 12.0 * (rho as f32 / 1e-3).sqrt(), "rho {rho}: {root}");
+        }
+    }
+
+    /// A bright wall behind snow: `Strongest` reports the wall (no flake outshines it), `Last` the
+    /// wall, `Dual` the flake in front and the wall behind it wherever the beam holds a detectable
+    /// flake. A dim far wall: `Strongest` reports whichever is stronger; `Last` still the wall.
+    /// All modes draw the same strongest particle per beam key, so the modes are compared beam by
+    /// beam.
+    #[test]
+    fn a_flake_in_front_of_a_wall_per_return_mode() {
+        let m = hdl();
+        let snow = Weather::Snow { rate_mm_h: 5.0 };
+        let mode = |mode| SensorWeather::new(&snow, &m).with_return_mode(mode);
+        let (strongest, last, dual) = (mode(ReturnMode::Strongest), mode(ReturnMode::Last), mode(ReturnMode::Dual));
+        assert_eq!(SensorWeather::new(&snow, &m).return_mode(), ReturnMode::Strongest);
+        // (range m, reflectance): a white wall at 15 m, a dark one at 60 m.
+        for (wall_m, rho) in [(15.0f32, 0.9f32), (60.0, 0.08)] {
+            let intensity = rho * (12.0 / wall_m).powi(2).min(1.0);
+            let wall = Some((wall_m, intensity));
+            let t2 = dual.transmission(wall_m);
+            let p_wall = unsaturated_power(&m, intensity, wall_m) * t2;
+            assert!(p_wall > dual.threshold(), "the wall is detectable");
+            let attenuated = BeamOutcome::Target { intensity: intensity * t2 };
+            let (mut flakes, mut flakes_win) = (0, 0);
+            for column in 0..20_000 {
+                let key = BeamKey { seed: 4, frame: 2, sensor: 0, ring: 7, column };
+                let (s, l, d) = (strongest.echoes(wall, &key), last.echoes(wall, &key), dual.echoes(wall, &key));
+                assert_eq!(l, BeamEchoes { first: attenuated, target_behind: None }, "last: the wall, always");
+                match d.first {
+                    BeamOutcome::Medium { range_m, intensity: flake, class } => {
+                        flakes += 1;
+                        assert_eq!(class, SemanticClass::SNOW);
+                        assert!(range_m < wall_m, "the flake lies in front: {range_m}");
+                        assert_eq!(d.target_behind, Some(intensity * t2), "dual: the wall behind the flake");
+                        let p_flake = unsaturated_power(&m, flake, range_m);
+                        if (p_flake / p_wall - 1.0).abs() < 1e-3 {
+                            continue; // a tie within rounding
+                        }
+                        if p_flake > p_wall {
+                            flakes_win += 1;
+                            assert_eq!(s, BeamEchoes { first: d.first, target_behind: None }, "strongest: the flake");
+                        } else {
+                            assert_eq!(s.first, attenuated, "strongest: the wall ({p_flake} < {p_wall})");
+                        }
+                    }
+                    other => {
+                        assert_eq!(other, attenuated);
+                        assert_eq!((d.target_behind, s.first), (None, attenuated), "no flake: the wall");
+                    }
+                }
+            }
+            eprintln!("wall {wall_m} m, rho {rho}: {flakes} flakes in front, {flakes_win} outshine it");
+            assert!(flakes > 100, "wall {wall_m} m: {flakes} beams of 20000 with a flake");
+            if wall_m < 20.0 {
+                assert_eq!(flakes_win, 0, "no flake outshines a white wall at {wall_m} m");
+            } else {
+                assert!(flakes_win > 10 && flakes_win < flakes, "{flakes_win} of {flakes} outshine the dark wall");
+            }
+        }
+        // Without a target (sky) every mode reports the same strongest flake, nothing behind it.
+        for column in 0..2_000 {
+            let key = BeamKey { seed: 4, frame: 2, sensor: 0, ring: 7, column };
+            let s = strongest.echoes(None, &key);
+            assert_eq!(s.target_behind, None);
+            assert_eq!(last.echoes(None, &key), s);
+            assert_eq!(dual.echoes(None, &key), s);
+        }
+    }
+
+    /// A catalogued model meets the weather in its `return_mode`; the other models in `Strongest`,
+    /// or in `Dual` (every echo, nearest first) when they report several echoes (the LUX).
+    #[test]
+    fn the_return_mode_comes_from_the_sensor() {
+        let mode = |spec: &SensorSpec| return_mode_of(spec, &spec.measurement());
+        let mut pandar = SensorSpec::default_for("pandar64").unwrap();
+        assert_eq!(mode(&pandar), ReturnMode::Strongest);
+        for want in [ReturnMode::Last, ReturnMode::Dual] {
+            if let SensorSpec::Pandar64(c) = &mut pandar {
+                c.return_mode = Some(want);
+            }
+            assert_eq!(mode(&pandar), want);
+        }
+        assert_eq!(mode(&SensorSpec::default_for("ibeo-lux").unwrap()), ReturnMode::Dual);
+        for model in ["vlp16", "hdl64e", "os1-128", "utm30lx", "custom"] {
+            assert_eq!(mode(&SensorSpec::default_for(model).unwrap()), ReturnMode::Strongest, "{model}");
         }
     }
 }

@@ -19,7 +19,13 @@ use serde::{Deserialize, Serialize};
 /// strongest), stored nearest first. For `Strongest` and `Last` the one simulated echo is the
 /// nearest surface a beam hits; where a beam straddles an edge and the sensor would pick the far
 /// surface (`Last`) or the brighter one (`Strongest`), the simulator does not (yet) choose
-/// differently: the weather issue uses these modes to pick among the echoes it adds.
+/// differently.
+///
+/// # In weather
+/// The medium's echo (a fog return, a drop, a flake) in front of the beam's surface is chosen by
+/// the mode ([`crate::effects::weather`], "Return modes"): `Strongest` reports it instead of the
+/// surface when it is the stronger; `Last` reports the surface whenever it is detectable; `Dual`
+/// reports the medium's echo in plane 0 and the surface behind it in plane 1.
 ///
 /// # In each output format
 /// - our PCD: HEIGHT = rows x planes, plane `k` occupies rows `k * R .. (k + 1) * R`, field `echo`;
