@@ -12,6 +12,10 @@
 
 use crate::error::{ClassifyError, Result};
 
+/// Smallest column offset [`BeamTable::from_pattern`] keeps, columns: below it, the rounding of
+/// the pattern's azimuths.
+pub const MIN_COLUMN_OFFSET: f32 = 1e-3;
+
 /// The physical layout needed to order a cloud.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BeamTable {
@@ -33,6 +37,11 @@ pub struct BeamTable {
     pub horizontal_offsets_m: Vec<f32>,
     /// Per beam: vertical origin offset above the sensor origin, metres (empty = all 0).
     pub vertical_offsets_m: Vec<f32>,
+    /// Per beam: how far its beam azimuth lies from its column's centre, in columns (positive:
+    /// towards later columns, clockwise; empty = all 0). A destaggered sensor's lasers fire up to
+    /// half a column either side of the centre (VLS-128, Ouster sensors at 512 columns); a point's
+    /// column is its beam azimuth's fractional column less this offset, rounded.
+    pub column_offsets: Vec<f32>,
 }
 
 impl BeamTable {
@@ -48,6 +57,7 @@ impl BeamTable {
             azimuth_offsets_rad: Vec::new(),
             horizontal_offsets_m: Vec::new(),
             vertical_offsets_m: Vec::new(),
+            column_offsets: Vec::new(),
         }
     }
 
@@ -65,8 +75,9 @@ impl BeamTable {
     }
 
     /// The table of a simulated sensor's pattern: row elevations, the columns' nominal azimuths, and
-    /// per row the origin offsets of its beams (read from the row's first firing). Refused for a
-    /// pattern with fewer than 2 rows or columns.
+    /// per row the origin offsets of its beams and its beams' offset from their column's centre in
+    /// columns (read from the row's first firing; offsets under [`MIN_COLUMN_OFFSET`] are 0).
+    /// Refused for a pattern with fewer than 2 rows or columns.
     pub fn from_pattern(pattern: &sim::sensor::ScanPattern) -> Result<Self> {
         let az = &pattern.col_azimuth_rad;
         if pattern.rows < 2 || az.len() < 2 {
@@ -80,13 +91,22 @@ impl BeamTable {
         let full_turn = (step * az.len() as f32 - std::f32::consts::TAU).abs() < 1.5 * step;
         let mut h = vec![0.0; pattern.rows];
         let mut v = vec![0.0; pattern.rows];
+        let mut column_offsets = vec![0.0; pattern.rows];
         for r in 0..pattern.rows {
-            if let Some(f) = (0..pattern.cols).find_map(|c| pattern.at(r, c)) {
+            if let Some((c, f)) = (0..pattern.cols).find_map(|c| pattern.at(r, c).map(|f| (c, f))) {
                 let o = f.origin_in_sensor;
                 let d = glam::Vec2::new(f.dir_in_sensor.x, f.dir_in_sensor.y).normalize_or_zero();
                 // Left of the beam = d rotated by +90 degrees.
                 h[r] = -o.x * d.y + o.y * d.x;
                 v[r] = o.z;
+                // Column c's centre less the beam's azimuth, in columns (within half a turn).
+                let beam = f64::from(f.dir_in_sensor.y).atan2(f64::from(f.dir_in_sensor.x));
+                let turn = std::f64::consts::TAU;
+                let off = (f64::from(az[c]) - beam).rem_euclid(turn);
+                let off = if off > 0.5 * turn { off - turn } else { off } / f64::from(step);
+                if off.abs() >= f64::from(MIN_COLUMN_OFFSET) {
+                    column_offsets[r] = off as f32;
+                }
             }
         }
         let any = |x: &[f32]| x.iter().any(|&a| a != 0.0);
@@ -99,6 +119,7 @@ impl BeamTable {
             azimuth_offsets_rad: Vec::new(),
             horizontal_offsets_m: if any(&h) { h } else { Vec::new() },
             vertical_offsets_m: if any(&v) { v } else { Vec::new() },
+            column_offsets: if any(&column_offsets) { column_offsets } else { Vec::new() },
         })
     }
 
@@ -118,6 +139,7 @@ impl BeamTable {
             ("azimuth offsets", &self.azimuth_offsets_rad),
             ("horizontal offsets", &self.horizontal_offsets_m),
             ("vertical offsets", &self.vertical_offsets_m),
+            ("column offsets", &self.column_offsets),
         ] {
             if !v.is_empty() && v.len() != n {
                 return Err(ClassifyError::Ordering(format!("beam table has {n} elevations but {} {name}", v.len())));
@@ -138,6 +160,7 @@ impl BeamTable {
         }
         let horizontal_m = pick(&self.horizontal_offsets_m);
         let vertical_m = pick(&self.vertical_offsets_m);
+        let column_offset = pick(&self.column_offsets);
         let mean_vertical_m = vertical_m.iter().sum::<f32>() / n as f32;
         let tan_elevation: Vec<f32> = elevation_rad.iter().map(|e| e.tan()).collect();
         Ok(TableRows {
@@ -146,6 +169,7 @@ impl BeamTable {
             elevation_rad,
             horizontal_m,
             vertical_m,
+            column_offset,
             mean_vertical_m,
             cols: self.cols,
             azimuth_left_rad: self.azimuth_left_rad,
@@ -166,6 +190,8 @@ pub struct TableRows {
     pub horizontal_m: Vec<f32>,
     /// Vertical origin offset per row, metres.
     pub vertical_m: Vec<f32>,
+    /// Offset of each row's beams from their column's centre, columns ([`BeamTable::column_offsets`]).
+    pub column_offset: Vec<f32>,
     /// Mean vertical offset, metres (for a first guess of a point's row).
     pub mean_vertical_m: f32,
     /// Columns.
@@ -346,10 +372,10 @@ impl TableRows {
         az - (h / d).asin()
     }
 
-    /// Fractional column steps from column 0 to azimuth `az` (wrapped into one turn for a full-turn
-    /// table); column = the nearest integer.
-    pub fn column_steps(&self, az: f32) -> f32 {
-        let steps = (self.azimuth_left_rad - az) / self.azimuth_step_rad;
+    /// Fractional column steps from column 0 to the beam azimuth `az` of row `row`, less the row's
+    /// column offset (wrapped into one turn for a full-turn table); column = the nearest integer.
+    pub fn column_steps(&self, az: f32, row: usize) -> f32 {
+        let steps = (self.azimuth_left_rad - az) / self.azimuth_step_rad - self.column_offset[row];
         if self.full_turn { wrap_into(steps, std::f32::consts::TAU / self.azimuth_step_rad) } else { steps }
     }
 }
