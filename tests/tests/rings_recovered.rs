@@ -17,14 +17,8 @@ fn spinning_roof_rigs() -> Vec<&'static str> {
     rigs
 }
 
-/// Fraction of the OS0-128's returns in their simulated cell in firing order without a rig
-/// (measured 0.9941): the garage's nearest points, seen from beam origins 2.7 cm out along the
-/// beam, sit more than a row from the row their elevation from the spin axis gives.
-const OS0_128_FIRING_FLOOR: f64 = 0.994;
-
-/// The same with the OS0-128's rig (measured 0.7522): the beam table's nearest row undoes the beam
-/// origins' height and sideways offset, not their offset out along the beam.
-const OS0_128_FIRING_WITH_RIG_FLOOR: f64 = 0.75;
+/// Fraction of the returns that must land in their simulated cell, for every sensor and order.
+const FLOOR: f64 = 0.999;
 
 /// Frame 0 of the garage (every laser, up or down, has returns) with `rig`, and the rig.
 fn scan(rig: &str) -> (OrderedCloud, sim::Rig) {
@@ -80,22 +74,18 @@ fn every_roof_sensor_is_named_and_its_rings_and_columns_recovered_in_both_orders
             assert_eq!(report.kept(), order.len(), "{what}");
             // Firing order: each point's row from its nearest beam and its column from its own
             // beam azimuth less its laser's offset from the column's centre, without the unfolded
-            // rings' running columns. The OS0-128 in firing order is the one exception
-            // ([`OS0_128_FIRING_FLOOR`]).
-            let floor = if order_kind == RecoveredOrder::Firing && rig_name == "os0-128-roof" {
-                OS0_128_FIRING_FLOOR
-            } else {
-                0.999
-            };
+            // rings' running columns; each row's beams seen from their origins (the OS0-128's
+            // 2.7 cm out along the beam: the garage's nearest points, a metre out, would sit rows
+            // away from the row their elevation from the spin axis gives).
             eprintln!("{what}: {right:.5} in their simulated cell");
-            assert!(right >= floor, "{what}: {:.5} in their simulated cell", right);
+            assert!(right >= FLOOR, "{what}: {:.5} in their simulated cell", right);
         }
     }
 }
 
 /// The same `.bin` files read with the sensor's rig (its beam table from the simulated pattern, its
-/// lasers' fractional column offsets included): at least 99.9 % of the returns in their simulated
-/// cell in either order, but for the OS0-128 in firing order ([`OS0_128_FIRING_WITH_RIG_FLOOR`]).
+/// lasers' fractional column offsets and its beam origins out along the beam included): at least
+/// 99.9 % of the returns in their simulated cell in either order.
 #[test]
 fn every_roof_sensor_read_with_its_rig_puts_its_returns_in_their_simulated_cells() {
     let mut short = Vec::new();
@@ -114,17 +104,12 @@ fn every_roof_sensor_read_with_its_rig_puts_its_returns_in_their_simulated_cells
             let what = format!("{rig_name} {order_name} with its rig: {}", report.summary());
             assert_eq!(shape, (cloud.rows, cloud.cols), "{what}");
             eprintln!("{what}: {right:.5} in their simulated cell");
-            let floor = if order_name == "firing" && rig_name == "os0-128-roof" {
-                OS0_128_FIRING_WITH_RIG_FLOOR
-            } else {
-                0.999
-            };
-            if right < floor {
+            if right < FLOOR {
                 short.push(format!("{rig_name} {order_name}: {right:.5}"));
             }
         }
     }
-    assert!(short.is_empty(), "under their floor in their simulated cell: {short:?}");
+    assert!(short.is_empty(), "under {FLOOR} in their simulated cell: {short:?}");
 }
 
 /// A driver's flat cloud with a ring field (the laser id: the channel's index in the vendor's
@@ -165,7 +150,7 @@ fn every_roof_sensor_read_from_a_ring_field_without_a_rig_gets_its_own_table() {
         eprintln!("{what}: {right:.5} in their simulated cell");
         // Rows come from the rings; columns from each point's beam azimuth less its laser's offset
         // from the column's centre (VLS-128: up to half a column).
-        assert!(right >= 0.999, "{what}: {right:.5} in their simulated cell");
+        assert!(right >= FLOOR, "{what}: {right:.5} in their simulated cell");
     }
 }
 

@@ -138,7 +138,7 @@ fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> (f6
     let mut held = vec![false; n];
     let (mut within, mut sum_deg) = (0usize, 0f64);
     for &k in sample {
-        let (best_row, best, outside) = row_of(rows, Some(&sensor.along_m), points[k as usize].xyz());
+        let (best_row, best, outside) = row_of(rows, Some(&rows.along_m), points[k as usize].xyz());
         held[best_row] = true;
         within += usize::from(!outside && best < 0.2);
         sum_deg += f64::from((best * gap(best_row) / (1.0 + tan[best_row] * tan[best_row])).to_degrees());
