@@ -18,6 +18,11 @@ use crate::error::{ClassifyError, Result};
 /// the pattern's azimuths.
 pub const MIN_COLUMN_OFFSET: f32 = 1e-3;
 
+/// Smallest beam origin offset out along the beam [`BeamTable::from_pattern`] keeps, metres: below
+/// it, the rounding of the pattern's origins and directions (the HDL-64E's origins, sideways and
+/// up, leave about 1e-12 m along the beam).
+pub const MIN_ALONG_M: f32 = 1e-6;
+
 /// The physical layout needed to order a cloud.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BeamTable {
@@ -81,9 +86,10 @@ impl BeamTable {
     }
 
     /// The table of a simulated sensor's pattern: row elevations, the columns' nominal azimuths, and
-    /// per row the origin offsets of its beams (up, sideways and out along the beam) and its beams' offset from their column's centre in
-    /// columns (read from the row's first firing; offsets under [`MIN_COLUMN_OFFSET`] are 0).
-    /// Refused for a pattern with fewer than 2 rows or columns.
+    /// per row the origin offsets of its beams (up, sideways and out along the beam) and its
+    /// beams' offset from their column's centre in columns (read from the row's first firing;
+    /// offsets under [`MIN_COLUMN_OFFSET`] and [`MIN_ALONG_M`] are 0). Refused for a pattern with
+    /// fewer than 2 rows or columns.
     pub fn from_pattern(pattern: &sim::sensor::ScanPattern) -> Result<Self> {
         let az = &pattern.col_azimuth_rad;
         if pattern.rows < 2 || az.len() < 2 {
@@ -106,7 +112,8 @@ impl BeamTable {
                 // Left of the beam = d rotated by +90 degrees.
                 h[r] = -o.x * d.y + o.y * d.x;
                 v[r] = o.z;
-                along[r] = o.x * d.x + o.y * d.y;
+                let a = o.x * d.x + o.y * d.y;
+                along[r] = if a.abs() < MIN_ALONG_M { 0.0 } else { a };
                 // Column c's centre less the beam's azimuth, in columns (within half a turn).
                 let beam = f64::from(f.dir_in_sensor.y).atan2(f64::from(f.dir_in_sensor.x));
                 let turn = std::f64::consts::TAU;
