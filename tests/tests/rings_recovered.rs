@@ -6,6 +6,7 @@
 //! sensor is named from the elevations the data shows and at least 99.9 % of its returns land in
 //! their simulated cell. The same `.bin` files read with the rig, and a labelled dataset of two
 //! sensors scored through `eval dataset`'s way in with and without each sequence's rig.
+
 use classifier::ordering::{CloudBuffer, OrderingReport, RecoveredOrder, SensorSetup};
 use gt_tests::{ScanSpec, scan_spec};
 use sim::OrderedCloud;
