@@ -8,9 +8,20 @@
 //! left of its azimuth and `vertical_offset_m` above the sensor origin, so a point at horizontal
 //! distance `d` seen by laser `r` lies at azimuth `beam + asin(h_r / d)` and height
 //! `v_r + sqrt(d^2 - h_r^2) * tan(elevation_r)`: [`TableRows::beam_azimuth`] and
-//! [`TableRows::nearest_row`] undo both.
+//! [`TableRows::nearest_row`] undo both. A beam whose origin lies `a_r` out along it (Ouster,
+//! RoboSense) reaches height `v_r + (d - a_r) * tan(elevation_r)`: [`TableRows::nearest_row`]
+//! undoes that too.
 
 use crate::error::{ClassifyError, Result};
+
+/// Smallest column offset [`BeamTable::from_pattern`] keeps, columns: below it, the rounding of
+/// the pattern's azimuths.
+pub const MIN_COLUMN_OFFSET: f32 = 1e-3;
+
+/// Smallest beam origin offset out along the beam [`BeamTable::from_pattern`] keeps, metres: below
+/// it, the rounding of the pattern's origins and directions (the HDL-64E's origins, sideways and
+/// up, leave about 1e-12 m along the beam).
+pub const MIN_ALONG_M: f32 = 1e-6;
 
 /// The physical layout needed to order a cloud.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,6 +44,14 @@ pub struct BeamTable {
     pub horizontal_offsets_m: Vec<f32>,
     /// Per beam: vertical origin offset above the sensor origin, metres (empty = all 0).
     pub vertical_offsets_m: Vec<f32>,
+    /// Per beam: origin offset out from the spin axis along the beam's azimuth, metres (empty =
+    /// all 0; Ouster and RoboSense sensors: 1 to 3 cm).
+    pub along_offsets_m: Vec<f32>,
+    /// Per beam: how far its beam azimuth lies from its column's centre, in columns (positive:
+    /// towards later columns, clockwise; empty = all 0). A destaggered sensor's lasers fire up to
+    /// half a column either side of the centre (VLS-128, Ouster sensors at 512 columns); a point's
+    /// column is its beam azimuth's fractional column less this offset, rounded.
+    pub column_offsets: Vec<f32>,
 }
 
 impl BeamTable {
@@ -48,6 +67,8 @@ impl BeamTable {
             azimuth_offsets_rad: Vec::new(),
             horizontal_offsets_m: Vec::new(),
             vertical_offsets_m: Vec::new(),
+            along_offsets_m: Vec::new(),
+            column_offsets: Vec::new(),
         }
     }
 
@@ -65,8 +86,10 @@ impl BeamTable {
     }
 
     /// The table of a simulated sensor's pattern: row elevations, the columns' nominal azimuths, and
-    /// per row the origin offsets of its beams (read from the row's first firing). Refused for a
-    /// pattern with fewer than 2 rows or columns.
+    /// per row the origin offsets of its beams (up, sideways and out along the beam) and its
+    /// beams' offset from their column's centre in columns (read from the row's first firing;
+    /// offsets under [`MIN_COLUMN_OFFSET`] and [`MIN_ALONG_M`] are 0). Refused for a pattern with
+    /// fewer than 2 rows or columns.
     pub fn from_pattern(pattern: &sim::sensor::ScanPattern) -> Result<Self> {
         let az = &pattern.col_azimuth_rad;
         if pattern.rows < 2 || az.len() < 2 {
@@ -80,13 +103,25 @@ impl BeamTable {
         let full_turn = (step * az.len() as f32 - std::f32::consts::TAU).abs() < 1.5 * step;
         let mut h = vec![0.0; pattern.rows];
         let mut v = vec![0.0; pattern.rows];
+        let mut along = vec![0.0; pattern.rows];
+        let mut column_offsets = vec![0.0; pattern.rows];
         for r in 0..pattern.rows {
-            if let Some(f) = (0..pattern.cols).find_map(|c| pattern.at(r, c)) {
+            if let Some((c, f)) = (0..pattern.cols).find_map(|c| pattern.at(r, c).map(|f| (c, f))) {
                 let o = f.origin_in_sensor;
                 let d = glam::Vec2::new(f.dir_in_sensor.x, f.dir_in_sensor.y).normalize_or_zero();
                 // Left of the beam = d rotated by +90 degrees.
                 h[r] = -o.x * d.y + o.y * d.x;
                 v[r] = o.z;
+                let a = o.x * d.x + o.y * d.y;
+                along[r] = if a.abs() < MIN_ALONG_M { 0.0 } else { a };
+                // Column c's centre less the beam's azimuth, in columns (within half a turn).
+                let beam = f64::from(f.dir_in_sensor.y).atan2(f64::from(f.dir_in_sensor.x));
+                let turn = std::f64::consts::TAU;
+                let off = (f64::from(az[c]) - beam).rem_euclid(turn);
+                let off = if off > 0.5 * turn { off - turn } else { off } / f64::from(step);
+                if off.abs() >= f64::from(MIN_COLUMN_OFFSET) {
+                    column_offsets[r] = off as f32;
+                }
             }
         }
         let any = |x: &[f32]| x.iter().any(|&a| a != 0.0);
@@ -99,6 +134,8 @@ impl BeamTable {
             azimuth_offsets_rad: Vec::new(),
             horizontal_offsets_m: if any(&h) { h } else { Vec::new() },
             vertical_offsets_m: if any(&v) { v } else { Vec::new() },
+            along_offsets_m: if any(&along) { along } else { Vec::new() },
+            column_offsets: if any(&column_offsets) { column_offsets } else { Vec::new() },
         })
     }
 
@@ -118,6 +155,8 @@ impl BeamTable {
             ("azimuth offsets", &self.azimuth_offsets_rad),
             ("horizontal offsets", &self.horizontal_offsets_m),
             ("vertical offsets", &self.vertical_offsets_m),
+            ("along offsets", &self.along_offsets_m),
+            ("column offsets", &self.column_offsets),
         ] {
             if !v.is_empty() && v.len() != n {
                 return Err(ClassifyError::Ordering(format!("beam table has {n} elevations but {} {name}", v.len())));
@@ -138,6 +177,10 @@ impl BeamTable {
         }
         let horizontal_m = pick(&self.horizontal_offsets_m);
         let vertical_m = pick(&self.vertical_offsets_m);
+        let column_offset = pick(&self.column_offsets);
+        let along_m = pick(&self.along_offsets_m);
+        let has_along = along_m.iter().any(|&a| a != 0.0);
+        let mean_along_m = along_m.iter().sum::<f32>() / n as f32;
         let mean_vertical_m = vertical_m.iter().sum::<f32>() / n as f32;
         let tan_elevation: Vec<f32> = elevation_rad.iter().map(|e| e.tan()).collect();
         Ok(TableRows {
@@ -146,6 +189,10 @@ impl BeamTable {
             elevation_rad,
             horizontal_m,
             vertical_m,
+            along_m,
+            has_along,
+            mean_along_m,
+            column_offset,
             mean_vertical_m,
             cols: self.cols,
             azimuth_left_rad: self.azimuth_left_rad,
@@ -166,6 +213,14 @@ pub struct TableRows {
     pub horizontal_m: Vec<f32>,
     /// Vertical origin offset per row, metres.
     pub vertical_m: Vec<f32>,
+    /// Origin offset out along the beam per row, metres.
+    pub along_m: Vec<f32>,
+    /// Whether any row's origin lies out along its beam (then [`TableRows::nearest_row`] undoes it).
+    pub has_along: bool,
+    /// Mean offset out along the beam, metres (for a first guess of a point's row).
+    pub mean_along_m: f32,
+    /// Offset of each row's beams from their column's centre, columns ([`BeamTable::column_offsets`]).
+    pub column_offset: Vec<f32>,
     /// Mean vertical offset, metres (for a first guess of a point's row).
     pub mean_vertical_m: f32,
     /// Columns.
@@ -260,12 +315,15 @@ impl TableRows {
         let tan = &self.tan_elevation;
         let inv_d = 1.0 / d2.sqrt().max(1e-6);
         let t0 = (p.z - self.mean_vertical_m) * inv_d;
+        let t0 = if self.has_along { t0 / (1.0 - self.mean_along_m * inv_d).max(1e-3) } else { t0 };
         let guess = self.guess.rows_below(tan, t0).min(n - 1);
-        // 1 / sqrt(d^2 - h^2) = (1 / d) (1 + h^2 / (2 d^2)) to well within 1e-6 for h << d.
+        // 1 / sqrt(d^2 - h^2) = (1 / d) (1 + h^2 / (2 d^2)) to well within 1e-6 for h << d; an
+        // origin `a` out along the beam: 1 / (d - a) = (1 / d) / (1 - a / d).
         let inv_d2 = inv_d * inv_d;
         let fine = |r: usize| {
             let h = self.horizontal_m[r];
-            (p.z - self.vertical_m[r]) * inv_d * (1.0 + 0.5 * h * h * inv_d2)
+            let f = (p.z - self.vertical_m[r]) * inv_d * (1.0 + 0.5 * h * h * inv_d2);
+            if self.has_along { f / (1.0 - self.along_m[r] * inv_d).max(1e-3) } else { f }
         };
         let (lo, hi) = (guess.saturating_sub(2), (guess + 2).min(n - 1));
         let mut best = (f32::INFINITY, guess, t0);
@@ -306,29 +364,44 @@ impl TableRows {
             *i = 1.0 / d.max(1e-6);
             *o = (*o - mean_v) * *i;
         }
+        if self.has_along {
+            for (o, &i) in out.iter_mut().zip(&inv) {
+                *o /= (1.0 - self.mean_along_m * i).max(1e-3);
+            }
+        }
         // Per first guess, its five candidate rows' vertical offset, `0.5 h h` (the same bits as
         // `nearest_row`'s left-to-right product) and `tan(elevation)`, side by side: the loop
         // below reads them without index clamps and bounds checks per candidate (it took 1.9 ms of
         // a 124 k-point KITTI frame ordered with origin offsets).
-        let candidates: Vec<[[f32; 3]; 5]> = (0..n)
+        let candidates: Vec<[[f32; 4]; 5]> = (0..n)
             .map(|g| {
                 let (lo, hi) = (g.saturating_sub(2), (g + 2).min(n - 1));
                 std::array::from_fn(|k| {
                     let r = (lo + k).min(hi);
-                    [v[r], 0.5 * h[r] * h[r], tan[r]]
+                    [v[r], 0.5 * h[r] * h[r], tan[r], self.along_m[r]]
                 })
             })
             .collect();
-        // Pass 2: the nearest row's fine value.
+        // Pass 2: the nearest row's fine value (a loop of its own for origins out along the beam,
+        // so that the others keep their one multiply per candidate).
+        let has_along = self.has_along;
         for (i, (o, &inv_d)) in out.iter_mut().zip(&inv).enumerate() {
             let (z, t0) = (z(i), *o);
             let guess = self.guess.rows_below(tan, t0).min(n - 1);
             let inv_d2 = inv_d * inv_d;
             let (mut best_e, mut best_f) = (f32::INFINITY, t0);
-            for [v_r, half_hh, tan_r] in candidates[guess] {
-                let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2);
-                let e = (f - tan_r).abs();
-                (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
+            if has_along {
+                for [v_r, half_hh, tan_r, a_r] in candidates[guess] {
+                    let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2) / (1.0 - a_r * inv_d).max(1e-3);
+                    let e = (f - tan_r).abs();
+                    (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
+                }
+            } else {
+                for [v_r, half_hh, tan_r, _] in candidates[guess] {
+                    let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2);
+                    let e = (f - tan_r).abs();
+                    (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
+                }
             }
             *o = best_f;
         }
@@ -346,10 +419,10 @@ impl TableRows {
         az - (h / d).asin()
     }
 
-    /// Fractional column steps from column 0 to azimuth `az` (wrapped into one turn for a full-turn
-    /// table); column = the nearest integer.
-    pub fn column_steps(&self, az: f32) -> f32 {
-        let steps = (self.azimuth_left_rad - az) / self.azimuth_step_rad;
+    /// Fractional column steps from column 0 to the beam azimuth `az` of row `row`, less the row's
+    /// column offset (wrapped into one turn for a full-turn table); column = the nearest integer.
+    pub fn column_steps(&self, az: f32, row: usize) -> f32 {
+        let steps = (self.azimuth_left_rad - az) / self.azimuth_step_rad - self.column_offset[row];
         if self.full_turn { wrap_into(steps, std::f32::consts::TAU / self.azimuth_step_rad) } else { steps }
     }
 }
@@ -439,27 +512,32 @@ mod tests {
         }
     }
 
-    /// The batch of fine elevations is bit for bit [`TableRows::nearest_row`]'s, with origin offsets.
+    /// The batch of fine elevations is bit for bit [`TableRows::nearest_row`]'s, with origin offsets
+    /// (up and sideways, and out along the beam).
     #[test]
     fn fine_tans_equal_nearest_row() {
         let mut table = BeamTable::hdl64e(2083);
         let n = table.elevations_rad.len();
         table.horizontal_offsets_m = (0..n).map(|i| 0.02 * ((i % 7) as f32 - 3.0)).collect();
         table.vertical_offsets_m = (0..n).map(|i| 0.2 + 0.003 * (i % 11) as f32).collect();
-        let rows = table.rows().unwrap();
-        let points: Vec<glam::Vec3> = (0..20_000)
-            .map(|i| {
-                let (a, r) = (i as f32 * 0.37, 0.5 + (i % 997) as f32 * 0.08);
-                glam::Vec3::new(r * a.cos(), r * a.sin(), -2.0 + (i % 389) as f32 * 0.01)
-            })
-            .collect();
-        let valid: Vec<u32> = (0..points.len() as u32).filter(|k| k % 5 != 3).collect();
-        let dist: Vec<f32> =
-            valid.iter().map(|&k| (points[k as usize].x.powi(2) + points[k as usize].y.powi(2)).sqrt()).collect();
-        let mut got = vec![0.0; valid.len()];
-        rows.fine_tans(&points, Some(&valid), &dist, &mut got);
-        for (g, &k) in got.iter().zip(&valid) {
-            assert_eq!(g.to_bits(), rows.nearest_row(points[k as usize]).1.to_bits(), "point {k}");
+        let mut with_along = table.clone();
+        with_along.along_offsets_m = (0..n).map(|i| 0.027 + 0.001 * (i % 3) as f32).collect();
+        for table in [table, with_along] {
+            let rows = table.rows().unwrap();
+            let points: Vec<glam::Vec3> = (0..20_000)
+                .map(|i| {
+                    let (a, r) = (i as f32 * 0.37, 0.5 + (i % 997) as f32 * 0.08);
+                    glam::Vec3::new(r * a.cos(), r * a.sin(), -2.0 + (i % 389) as f32 * 0.01)
+                })
+                .collect();
+            let valid: Vec<u32> = (0..points.len() as u32).filter(|k| k % 5 != 3).collect();
+            let dist: Vec<f32> =
+                valid.iter().map(|&k| (points[k as usize].x.powi(2) + points[k as usize].y.powi(2)).sqrt()).collect();
+            let mut got = vec![0.0; valid.len()];
+            rows.fine_tans(&points, Some(&valid), &dist, &mut got);
+            for (g, &k) in got.iter().zip(&valid) {
+                assert_eq!(g.to_bits(), rows.nearest_row(points[k as usize]).1.to_bits(), "point {k}");
+            }
         }
     }
 }

@@ -21,7 +21,7 @@ pub(crate) fn table_wishes<P: InputPoint>(
         let p = points[k as usize].xyz();
         let (row, _, outside) = rows.nearest_row(p);
         report.outside += usize::from(outside);
-        let steps = rows.column_steps(rows.beam_azimuth(p, row));
+        let steps = rows.column_steps(rows.beam_azimuth(p, row), row);
         wishes.push(Wish { row: row as u32, steps });
     }
     wishes
@@ -76,7 +76,7 @@ pub(crate) fn ring_wishes<P: InputPoint>(
         let g = rings[k as usize] as usize;
         let row = if bottom_first { g } else { n - 1 - g };
         let p = points[k as usize].xyz();
-        wishes.push(Wish { row: row as u32, steps: rows.column_steps(rows.beam_azimuth(p, row)) });
+        wishes.push(Wish { row: row as u32, steps: rows.column_steps(rows.beam_azimuth(p, row), row) });
     }
     Ok(wishes)
 }

@@ -57,19 +57,19 @@ pub(crate) fn recover_firing<P: InputPoint>(
     let stride = n.div_ceil(FIT_SAMPLES).max(1);
     let sample: Vec<u32> = (0..n).step_by(stride).map(index).collect();
     let matched = match_points(points, &sample);
-    let (rows, along_m, rings, mean_error_deg) = match &matched {
-        Some(m) => (m.sensor.rows.clone(), Some(&m.sensor.along_m[..]), m.sensor.rows.len(), Some(m.mean_error_deg)),
+    let (rows, matched_rows, rings, mean_error_deg) = match &matched {
+        Some(m) => (m.sensor.rows.clone(), true, m.sensor.rows.len(), Some(m.mean_error_deg)),
         None => {
             let tan = unnamed_elevations(points, usable, n)?;
             let rows = unnamed_table(&tan, 2).rows().map_err(|e| e.to_string())?;
-            (rows, None, tan.len(), None)
+            (rows, false, tan.len(), None)
         }
     };
     // Each point's row: its nearest beam seen from the beam's origin.
     let mut point_rows = vec![0u16; points.len()];
     for i in 0..n {
         let k = index(i) as usize;
-        point_rows[k] = row_of(&rows, along_m, points[k].xyz()).0 as u16;
+        point_rows[k] = row_of(&rows, matched_rows.then_some(&rows.along_m[..]), points[k].xyz()).0 as u16;
     }
     // Columns: the azimuth step between successive points of one row.
     let window = n.min(WINDOW);

@@ -10,16 +10,13 @@ use sim::sensor::{SensorSpec, catalogue::ColumnRule};
 
 use super::super::beam_table::{BeamTable, TableRows};
 
-/// A spinning model's nominal table and its column options.
+/// A spinning model's nominal table (origin offsets up, sideways and out along the beam included)
+/// and its column options.
 pub(crate) struct KnownSensor {
     /// TOML model name (`hdl32e`, ...).
     pub model: &'static str,
     /// The default settings' table, rows sorted up (elevations and origin offsets).
     pub rows: TableRows,
-    /// Per row, how far its beam origin lies out along the beam's azimuth, metres (Ouster,
-    /// RoboSense: a few centimetres; the table's rows undo only the offsets across the beam and
-    /// up).
-    pub along_m: Vec<f32>,
     /// The settings of each rotation rate or lidar mode, with the columns they give.
     pub options: Vec<(usize, SensorSpec)>,
 }
@@ -39,17 +36,8 @@ fn known(model: &'static str) -> Option<KnownSensor> {
     let spec = SensorSpec::default_for(model).ok()?;
     let pattern = spec.pattern();
     let rows = BeamTable::from_pattern(&pattern).ok()?.rows().ok()?;
-    // The pattern's rows are sorted up, as the table's.
-    let along_m = (0..pattern.rows)
-        .map(|r| {
-            (0..pattern.cols).find_map(|c| pattern.at(r, c)).map_or(0.0, |f| {
-                let d = glam::Vec2::new(f.dir_in_sensor.x, f.dir_in_sensor.y).normalize_or_zero();
-                f.origin_in_sensor.x * d.x + f.origin_in_sensor.y * d.y
-            })
-        })
-        .collect();
     let options = column_options(&spec);
-    Some(KnownSensor { model, rows, along_m, options })
+    Some(KnownSensor { model, rows, options })
 }
 
 /// The settings of every rotation rate (and Ouster lidar mode) of `spec`'s model that validates,

@@ -47,9 +47,21 @@ fn tan_diff_deg(a: f32, b: f32, t: f32) -> f32 {
     ((a - b).abs() / (1.0 + t * t)).to_degrees()
 }
 
-/// The monotone alignment of `medians` (sorted up, with each ring's median distance `dist_m`) to
-/// `rows`: the summed and the largest error, degrees; `None` where there are more rings than rows.
-fn align(medians: &[f32], dist_m: &[f32], rows: &TableRows) -> Option<(f32, f32)> {
+/// The monotone alignment of rings to a table's rows with the least summed error
+/// ([`align`]): each ring's row and the fit's figures.
+pub(crate) struct Alignment {
+    /// Per ring (in the order given: sorted up), its row of the table.
+    pub rows: Vec<usize>,
+    /// Summed error of the rings against their rows, degrees.
+    pub sum_deg: f32,
+    /// Largest error of one ring against its row, degrees.
+    pub worst_deg: f32,
+}
+
+/// The monotone alignment of `medians` (`tan(elevation)` seen from the sensor origin, sorted up,
+/// with each ring's median distance `dist_m`) to `rows` that may skip rows (a laser without
+/// returns) and minimises the summed error; `None` where there are more rings than rows.
+pub(crate) fn align(medians: &[f32], dist_m: &[f32], rows: &TableRows) -> Option<Alignment> {
     let (k, r) = (medians.len(), rows.len());
     if k == 0 || k > r {
         return None;
@@ -58,27 +70,39 @@ fn align(medians: &[f32], dist_m: &[f32], rows: &TableRows) -> Option<(f32, f32)
         let seen = rows.tan_elevation[j] + rows.vertical_m[j] / dist_m[i].max(0.5);
         tan_diff_deg(medians[i], seen, medians[i])
     };
-    // cost[i * r + j]: rings 0..=i aligned, ring i to row j; `worst` the largest error on that path.
+    // cost[i * r + j]: rings 0..=i aligned, ring i to row j; `worst` the largest error on that
+    // path; `from` ring i - 1's row on it.
     let inf = f32::INFINITY;
     let mut cost = vec![inf; k * r];
     let mut worst = vec![inf; k * r];
+    let mut from = vec![0usize; k * r];
     for j in 0..=(r - k) {
         cost[j] = err(0, j);
         worst[j] = cost[j];
     }
     for i in 1..k {
-        let mut run = (inf, inf);
+        let mut run = (inf, inf, 0usize);
         for j in i..=(r - k + i) {
             let prev = (cost[(i - 1) * r + j - 1], worst[(i - 1) * r + j - 1]);
             if prev.0 < run.0 {
-                run = prev;
+                run = (prev.0, prev.1, j - 1);
             }
             let e = err(i, j);
             cost[i * r + j] = run.0 + e;
             worst[i * r + j] = run.1.max(e);
+            from[i * r + j] = run.2;
         }
     }
-    (k - 1..r).map(|j| (cost[(k - 1) * r + j], worst[(k - 1) * r + j])).min_by(|a, b| a.0.total_cmp(&b.0))
+    let mut j = (k - 1..r).min_by(|&a, &b| cost[(k - 1) * r + a].total_cmp(&cost[(k - 1) * r + b]))?;
+    let (sum_deg, worst_deg) = (cost[(k - 1) * r + j], worst[(k - 1) * r + j]);
+    let mut out = vec![0usize; k];
+    for i in (0..k).rev() {
+        out[i] = j;
+        if i > 0 {
+            j = from[i * r + j];
+        }
+    }
+    Some(Alignment { rows: out, sum_deg, worst_deg })
 }
 
 /// The known sensor whose table the rings' `medians` (`tan(elevation)` seen from the origin,
@@ -91,9 +115,9 @@ pub(crate) fn match_rings(medians: &[f32], dist_m: &[f32]) -> Option<Matched> {
         if k > r || 4 * (r - k) > r {
             continue;
         }
-        let Some((sum, worst)) = align(medians, dist_m, &sensor.rows) else { continue };
-        let mean = sum / k as f32;
-        if mean > MATCH_MEAN_DEG || worst > MATCH_MAX_DEG {
+        let Some(fit) = align(medians, dist_m, &sensor.rows) else { continue };
+        let mean = fit.sum_deg / k as f32;
+        if mean > MATCH_MEAN_DEG || fit.worst_deg > MATCH_MAX_DEG {
             continue;
         }
         let score = mean + MISSING_ROW_DEG * (r - k) as f32;
@@ -114,7 +138,7 @@ fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> (f6
     let mut held = vec![false; n];
     let (mut within, mut sum_deg) = (0usize, 0f64);
     for &k in sample {
-        let (best_row, best, outside) = row_of(rows, Some(&sensor.along_m), points[k as usize].xyz());
+        let (best_row, best, outside) = row_of(rows, Some(&rows.along_m), points[k as usize].xyz());
         held[best_row] = true;
         within += usize::from(!outside && best < 0.2);
         sum_deg += f64::from((best * gap(best_row) / (1.0 + tan[best_row] * tan[best_row])).to_degrees());
@@ -174,6 +198,20 @@ pub(crate) fn match_points<P: InputPoint>(points: &[P], sample: &[u32]) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The alignment traces back each ring's row: a table's rows without its third and its top
+    /// row (lasers without returns) go to their own rows, with no error.
+    #[test]
+    fn alignment_gives_each_ring_its_row_past_skipped_rows() {
+        let rows = &known_sensors()[0].rows;
+        let n = rows.len();
+        let kept: Vec<usize> = (0..n - 1).filter(|&j| j != 2).collect();
+        let medians: Vec<f32> = kept.iter().map(|&j| rows.tan_elevation[j] + rows.vertical_m[j] / 20.0).collect();
+        let a = align(&medians, &vec![20.0; kept.len()], rows).expect("aligned");
+        assert_eq!(a.rows, kept);
+        assert!(a.sum_deg < 1e-3 && a.worst_deg < 1e-3, "{} {}", a.sum_deg, a.worst_deg);
+        assert!(align(&vec![0.0; n + 1], &vec![20.0; n + 1], rows).is_none());
+    }
 
     /// Each known table's own elevations (seen from the origin at 20 m) match that table, also
     /// with its two top lasers missing; the same elevations 2 degrees higher match none.

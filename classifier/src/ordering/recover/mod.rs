@@ -241,6 +241,8 @@ fn named_table(sensor: &known::KnownSensor, cols_estimate: usize) -> (BeamTable,
     let mut t = factory.unwrap_or_else(|| unnamed_table(&sensor.rows.tan_elevation, cols_estimate));
     let step = TAU / cols_estimate as f32;
     (t.cols, t.azimuth_step_rad, t.azimuth_left_rad) = (cols_estimate, step, PI - 0.5 * step);
+    // Its lasers' column offsets are in the listed rate's columns: left out.
+    t.column_offsets.clear();
     (t, cols_estimate)
 }
 
@@ -346,7 +348,7 @@ pub(crate) fn cell_of(rows: &TableRows, p: glam::Vec3) -> u32 {
 
 /// The plane-0 cell of `p` in row `row` of the grid of `rows`: the column of its beam azimuth.
 pub(crate) fn cell_in(rows: &TableRows, row: usize, p: glam::Vec3) -> u32 {
-    let steps = rows.column_steps(rows.beam_azimuth(p, row));
+    let steps = rows.column_steps(rows.beam_azimuth(p, row), row);
     let col = wrap_into(round_fast(steps), rows.cols as f32);
     let col = if col.is_finite() && col >= 0.0 { (col as usize).min(rows.cols - 1) } else { 0 };
     (row * rows.cols + col) as u32

@@ -10,7 +10,7 @@
 use std::f32::consts::TAU;
 
 use super::super::InputPoint;
-use super::super::beam_table::{BeamTable, TableRows};
+use super::super::beam_table::BeamTable;
 use super::super::unfold::sampled_median;
 use super::{RecoveredOrder, RecoveredSensor, RecoveryError, matching, named_table, unnamed_table};
 
@@ -107,7 +107,7 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
         Some(m) => {
             let (table, columns) = named_table(m.sensor, cols_estimate);
             let rows = table.rows().map_err(|e| RecoveryError::NoOrder { points: n_usable, why: e.to_string() })?;
-            let row_of = align_rows(&tan_sorted, &dist_sorted, &rows);
+            let row_of = matching::align(&tan_sorted, &dist_sorted, &rows).map(|a| a.rows);
             (table, columns, row_of)
         }
         None => (unnamed_table(&tan_sorted, cols_estimate), cols_estimate, None),
@@ -132,46 +132,6 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
         table,
         point_rows,
     })
-}
-
-/// The row of each ring (`medians`: `tan(elevation)` seen from the origin, sorted up, at median
-/// distances `dist_m`) in the monotone alignment to `rows` with the least summed error
-/// ([`matching`]'s alignment, traced back); `None` where there are more rings than rows.
-fn align_rows(medians: &[f32], dist_m: &[f32], rows: &TableRows) -> Option<Vec<usize>> {
-    let (k, r) = (medians.len(), rows.len());
-    if k == 0 || k > r {
-        return None;
-    }
-    let err = |i: usize, j: usize| {
-        let seen = rows.tan_elevation[j] + rows.vertical_m[j] / dist_m[i].max(0.5);
-        (medians[i] - seen).abs()
-    };
-    // cost[i * r + j]: rings 0..=i aligned, ring i to row j; from[i * r + j]: ring i - 1's row.
-    let mut cost = vec![f32::INFINITY; k * r];
-    let mut from = vec![0usize; k * r];
-    for (j, c) in cost.iter_mut().enumerate().take(r - k + 1) {
-        *c = err(0, j);
-    }
-    for i in 1..k {
-        let mut run = (f32::INFINITY, 0usize);
-        for j in i..=(r - k + i) {
-            let prev = cost[(i - 1) * r + j - 1];
-            if prev < run.0 {
-                run = (prev, j - 1);
-            }
-            cost[i * r + j] = run.0 + err(i, j);
-            from[i * r + j] = run.1;
-        }
-    }
-    let mut j = (k - 1..r).min_by(|&a, &b| cost[(k - 1) * r + a].total_cmp(&cost[(k - 1) * r + b]))?;
-    let mut out = vec![0usize; k];
-    for i in (0..k).rev() {
-        out[i] = j;
-        if i > 0 {
-            j = from[i * r + j];
-        }
-    }
-    Some(out)
 }
 
 #[cfg(test)]

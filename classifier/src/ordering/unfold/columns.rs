@@ -51,11 +51,11 @@ fn round_all(v: &mut [f32]) {
 /// into `steps`.
 #[inline(always)]
 pub(crate) fn column_steps(rows: &TableRows, row: usize, az: &[f32], dist: &[f32], steps: &mut Vec<f32>) {
-    let h = rows.horizontal_m[row];
+    let (h, offset) = (rows.horizontal_m[row], rows.column_offset[row]);
     let (left, step) = (rows.azimuth_left_rad, rows.azimuth_step_rad);
     steps.clear();
     if h == 0.0 {
-        steps.extend(az.iter().map(|&a| (left - a) / step));
+        steps.extend(az.iter().map(|&a| (left - a) / step - offset));
     } else {
         // The operations of `column_steps(a - asin(h / d))` in passes: the ratios and the steps
         // vectorize, only libm's `asin` is a call per point (one pass of calls took 0.8 ms of a
@@ -63,7 +63,7 @@ pub(crate) fn column_steps(rows: &TableRows, row: usize, az: &[f32], dist: &[f32
         steps.extend(dist.iter().map(|&d| h / d.max(h.abs() * 1.0001)));
         steps.iter_mut().for_each(|x| *x = x.asin());
         for (s, &a) in steps.iter_mut().zip(az) {
-            *s = (left - (a - *s)) / step;
+            *s = (left - (a - *s)) / step - offset;
         }
     }
     if rows.full_turn {
@@ -209,7 +209,7 @@ mod tests {
     /// The rule as first written, per point, for comparison.
     fn reference(rows: &TableRows, az: &[f32], dir: f32) -> Vec<u32> {
         let (cols, col_dir) = (rows.cols as f32, -dir);
-        let steps: Vec<f32> = az.iter().map(|&a| rows.column_steps(a)).collect();
+        let steps: Vec<f32> = az.iter().map(|&a| rows.column_steps(a, 0)).collect();
         let mut u = steps[0];
         let mut unwrapped = vec![u];
         for pair in steps.windows(2) {
@@ -273,14 +273,15 @@ mod tests {
         assert_eq!(v, [1e6, 9e6]);
     }
 
-    /// The batch steps are bit for bit `column_steps(beam_azimuth(p, row))` per point, with and
-    /// without a horizontal origin offset, over a full turn and short of one.
+    /// The batch steps are bit for bit `column_steps(beam_azimuth(p, row), row)` per point, with and
+    /// without a horizontal origin offset and a column offset, over a full turn and short of one.
     #[test]
     fn batch_steps_equal_the_per_point_definition() {
         for full_turn in [true, false] {
             let mut table = BeamTable::hdl64e(2083);
             let n = table.elevations_rad.len();
             table.horizontal_offsets_m = (0..n).map(|i| 0.026 * ((i % 5) as f32 - 2.0)).collect();
+            table.column_offsets = (0..n).map(|i| 0.25 * ((i % 3) as f32 - 1.0)).collect();
             let mut rows = table.rows().unwrap();
             rows.full_turn = full_turn;
             let points: Vec<glam::Vec3> = (0..5_000)
@@ -294,7 +295,7 @@ mod tests {
             for row in [0, 1, 2, 3, 4] {
                 column_steps(&rows, row, &az, &dist, &mut steps);
                 for (k, (s, p)) in steps.iter().zip(&points).enumerate() {
-                    let want = rows.column_steps(rows.beam_azimuth(*p, row));
+                    let want = rows.column_steps(rows.beam_azimuth(*p, row), row);
                     assert_eq!(s.to_bits(), want.to_bits(), "row {row} point {k} full turn {full_turn}");
                 }
             }
