@@ -18,6 +18,7 @@ pub const METHODS: &[&str] = &[
     "ransac",
     "grid",
     "grid-no-cluster",
+    "grid-dror",
     "mcdaniel",
     "learned",
 ];
@@ -144,6 +145,10 @@ pub fn method_by_name(name: &str, seed: u64) -> Result<Box<dyn GroundClassifier 
         "grid-no-cluster" => Box::new(GridMethod(
             "grid-no-cluster",
             GridAccumulation::new(GridParams { cluster: false, ..Default::default() })?,
+        )),
+        "grid-dror" => Box::new(GridMethod(
+            "grid-dror",
+            GridAccumulation::new(GridParams { isolation: Some(Default::default()), ..Default::default() })?,
         )),
         "mcdaniel" => mcdaniel_with_model(crate::mcdaniel::default_model()?, McDanielParams::default())?,
         "learned" => learned_with_model(crate::learned::default_model()?)?,

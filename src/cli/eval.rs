@@ -72,6 +72,14 @@ struct SceneArgs {
     /// Turn measurement effects off.
     #[arg(long)]
     ideal: bool,
+    /// Weather per beam: `clear`, `fog:visibility_m=V`, `rain:rate_mm_h=R` or `snow:rate_mm_h=R`
+    /// (default: the scene file's `[weather]`, else none; docs/weather.md). Particles are never
+    /// ground: a method that calls them ground loses precision.
+    #[arg(long)]
+    weather: Option<String>,
+    /// Snow lying on the ground, metres (`0 < depth <= 1`; labelled terrain, i.e. ground).
+    #[arg(long)]
+    snow_cover_m: Option<f64>,
     #[command(flatten)]
     report: ReportArgs,
 }
@@ -262,6 +270,8 @@ impl LegacyArgs {
             seed: self.seed,
             speed_m_per_s: self.speed,
             ideal: self.ideal,
+            weather: None,
+            snow_cover_m: None,
             report: ReportArgs { json: self.json, details: self.details, model: self.model },
         }))
     }
@@ -330,9 +340,12 @@ fn run_scene(args: &SceneArgs) -> anyhow::Result<()> {
         frames: args.frames as u64,
         speed_m_per_s: f64::from(args.speed_m_per_s),
         ideal: args.ideal,
+        weather: args.weather.as_deref().map(sim::effects::weather::Weather::parse).transpose().context("--weather")?,
+        snow_cover_m: args.snow_cover_m,
         ..Default::default()
     })?;
-    println!("scene {scene_name} rig {rig_name} frames {} seed {}", frames.len(), args.seed);
+    let weather = args.weather.as_deref().map(|w| format!(" weather {w}")).unwrap_or_default();
+    println!("scene {scene_name} rig {rig_name} frames {} seed {}{weather}", frames.len(), args.seed);
     println!("{:<24} {:>7} {:>7} {:>9} {:>7} {:>7} {:>7}", "method", "acc", "FPR", "precision", "recall", "F1", "IoU");
     let mut json: BTreeMap<String, Scores> = BTreeMap::new();
     for name in &names {

@@ -13,11 +13,16 @@
 //! (the frame is its own map). With clustering, the points the grid calls ground are the candidates
 //! of the clustering and cluster rules of [`crate::nitsch::cluster`] (plane 0; other planes as in
 //! [`crate::nitsch`]); without, every return is tested against the map directly.
+//!
+//! With `isolation` (`grid-dror`), isolated returns ([`crate::baselines::isolated`]: falling snow,
+//! rain drops) are left out of the map and are never ground: without it a flake's `g_rho` of about 0
+//! pulls the square's mean below the threshold and the ground under it is lost.
 
 use std::collections::HashMap;
 
 use glam::{Affine3A, Vec3};
 
+use crate::baselines::isolated::{IsolationParams, isolated_returns};
 use crate::error::{ClassifyError, Result, check_cloud, is_valid};
 use crate::nitsch::{Nitsch, NitschParams, echoes_from_plane0};
 
@@ -32,6 +37,9 @@ pub struct GridParams {
     pub cluster: bool,
     /// Feature, threshold (0.7 in Table I) and clustering parameters.
     pub nitsch: NitschParams,
+    /// The particle filter stage: isolated returns left out of the map and never ground (`None` in
+    /// Table I's `grid`).
+    pub isolation: Option<IsolationParams>,
 }
 
 impl Default for GridParams {
@@ -41,6 +49,7 @@ impl Default for GridParams {
             max_height_m: 0.15,
             cluster: true,
             nitsch: NitschParams { threshold: 0.7, ..Default::default() },
+            isolation: None,
         }
     }
 }
@@ -60,6 +69,7 @@ pub struct GridAccumulation {
     nitsch: Nitsch,
     map: HashMap<(i32, i32), Square>,
     world: Vec<Vec3>,
+    isolated: Vec<bool>,
 }
 
 impl GridAccumulation {
@@ -71,7 +81,28 @@ impl GridAccumulation {
         if !(params.max_height_m.is_finite() && params.max_height_m >= 0.0) {
             return Err(ClassifyError::invalid("max_height_m", params.max_height_m, "finite, >= 0"));
         }
-        Ok(Self { params, nitsch: Nitsch::new(params.nitsch)?, map: HashMap::new(), world: Vec::new() })
+        if let Some(iso) = &params.isolation {
+            if !(iso.radius_multiplier.is_finite() && iso.radius_multiplier >= 0.0) {
+                return Err(ClassifyError::invalid(
+                    "isolation.radius_multiplier",
+                    iso.radius_multiplier,
+                    "finite, >= 0",
+                ));
+            }
+            if !(iso.min_radius_m.is_finite() && iso.min_radius_m >= 0.0) {
+                return Err(ClassifyError::invalid("isolation.min_radius_m", iso.min_radius_m, "finite, >= 0"));
+            }
+            if iso.min_neighbours == 0 {
+                return Err(ClassifyError::invalid("isolation.min_neighbours", iso.min_neighbours, ">= 1"));
+            }
+        }
+        Ok(Self {
+            params,
+            nitsch: Nitsch::new(params.nitsch)?,
+            map: HashMap::new(),
+            world: Vec::new(),
+            isolated: Vec::new(),
+        })
     }
 
     /// Number of squares in the map.
@@ -111,9 +142,14 @@ impl GridAccumulation {
         self.world.extend(cloud.point_in_vehicle.iter().map(|&p| pose.transform_point3(p)));
         let n0 = cloud.rows * cloud.cols;
         let thr = self.params.nitsch.threshold;
+        match &self.params.isolation {
+            Some(params) => isolated_returns(cloud, params, &mut self.isolated),
+            None => self.isolated.clear(),
+        }
+        let isolated = |i: usize| self.isolated.get(i).copied().unwrap_or(false);
         for i in 0..n0 {
             let p = self.world[i];
-            if !is_valid(p) {
+            if !is_valid(p) || isolated(i) {
                 continue;
             }
             let g = self.nitsch.features.g_rho[i];
@@ -126,7 +162,9 @@ impl GridAccumulation {
                 s.z_count += 1;
             }
         }
-        let mut out: Vec<bool> = self.world.iter().map(|&p| is_valid(p) && self.is_ground(p)).collect();
+        let isolated = |i: usize| self.isolated.get(i).copied().unwrap_or(false);
+        let mut out: Vec<bool> =
+            self.world.iter().enumerate().map(|(i, &p)| is_valid(p) && !isolated(i) && self.is_ground(p)).collect();
         if self.params.cluster {
             let candidate = out[..n0].to_vec();
             let ws = &mut ClusterState::default();
