@@ -238,6 +238,7 @@ mod tests {
         for layout in [PcdLayout::Groundtruth, PcdLayout::Velodyne, PcdLayout::Ouster] {
             let pcd = encode_layout(&cloud(), layout, false, None).unwrap();
             let msg = from_pcd(&pcd, Header::default()).unwrap();
+            assert!(matches!(msg.data, Cow::Borrowed(_)), "the data is borrowed from the PCD bytes");
             assert_eq!((msg.height, msg.width), (2, 3), "{layout:?}");
             assert_eq!(msg.data.len(), 6 * msg.point_step as usize);
             let name = std::path::Path::new("b#/points[0]");
