@@ -1,5 +1,5 @@
-//! rosbag2 directories with one MCAP file, written as `ros2 bag record -s mcap` writes them and
-//! read from theirs and anyone else's: `metadata.yaml` beside `NAME_0.mcap`, messages in ROS 2
+//! rosbag2 directories with one MCAP file, written as `ros2 bag record -s mcap
+//! --storage-preset-profile zstd_fast` writes them and read from theirs and anyone else's: `metadata.yaml` beside `NAME_0.mcap`, messages in ROS 2
 //! `cdr`, schemas as `ros2msg` text, the MCAP chunked (768 KiB) and compressed with zstd level -5
 //! (rosbag2's `zstd_fast` preset, libmcap's `Fastest`; or uncompressed, [`BagCompression::None`]),
 //! topics with their QoS profiles (`/tf_static` transient local).
