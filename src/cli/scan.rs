@@ -88,8 +88,8 @@ pub struct Args {
     /// terrain (72) with snow's reflectivity.
     #[arg(long)]
     pub snow_cover_m: Option<f64>,
-    /// Chunk compression of the bag (`--format mcap`): `zstd` (level 1, as `ros2 bag record -s
-    /// mcap` writes) or `none` (larger files, no compression work).
+    /// Chunk compression of the bag (`--format mcap`): `zstd` (level -5, rosbag2's `zstd_fast`
+    /// preset) or `none` (larger files, no compression work).
     #[arg(long, default_value = "zstd")]
     pub bag_compression: String,
     /// Worker threads (default: all cores). Results are identical at any count.

@@ -55,8 +55,9 @@ fn pcd_parts(pcd: &[u8]) -> Result<PcdParts<'_>, CloudError> {
 }
 
 /// The PointCloud2 of binary PCD bytes as our writers emit them (organized: `height` rows of
-/// `width` points), stamped with `header`. The data is copied once.
-pub fn from_pcd(pcd: &[u8], header: Header) -> Result<PointCloud2<'static>, CloudError> {
+/// `width` points), stamped with `header`. The data is borrowed from `pcd`, not copied: a bag
+/// writer copies it once, into the message's CDR bytes.
+pub fn from_pcd(pcd: &[u8], header: Header) -> Result<PointCloud2<'_>, CloudError> {
     let parts = pcd_parts(pcd)?;
     let mut fields = Vec::with_capacity(parts.fields.len());
     let mut offset = 0u32;
@@ -79,7 +80,7 @@ pub fn from_pcd(pcd: &[u8], header: Header) -> Result<PointCloud2<'static>, Clou
         is_bigendian: false,
         point_step,
         row_step: point_step * parts.width as u32,
-        data: Cow::Owned(parts.body.to_vec()),
+        data: Cow::Borrowed(parts.body),
         is_dense,
     })
 }
@@ -237,6 +238,7 @@ mod tests {
         for layout in [PcdLayout::Groundtruth, PcdLayout::Velodyne, PcdLayout::Ouster] {
             let pcd = encode_layout(&cloud(), layout, false, None).unwrap();
             let msg = from_pcd(&pcd, Header::default()).unwrap();
+            assert!(matches!(msg.data, Cow::Borrowed(_)), "the data is borrowed from the PCD bytes");
             assert_eq!((msg.height, msg.width), (2, 3), "{layout:?}");
             assert_eq!(msg.data.len(), 6 * msg.point_step as usize);
             let name = std::path::Path::new("b#/points[0]");

@@ -164,4 +164,50 @@ mod tests {
             assert_eq!(points, 2 * frames[0].cloud.rows * frames[0].cloud.cols * planes);
         }
     }
+
+    /// The default compression (zstd level -5) and none give the same messages: the same CDR
+    /// bytes at the same times, what an uncompressed scan writes; the zstd file is the smaller.
+    #[test]
+    fn compressed_and_uncompressed_bags_hold_the_same_messages() {
+        let mesh = crate::scene::builtin::flat();
+        let rig = crate::Rig::load("lux-roof-4").unwrap();
+        let config = crate::scan::ScanConfig { frames: 2, ideal: true, speed_m_per_s: 5.0, ..Default::default() };
+        let frames = crate::scan::scan(&mesh, &rig, &config).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let sensors = sensor_topics(&rig);
+        let write = |name: &str, compression| {
+            let path = dir.path().join(name);
+            let mut bag = BagWriter::create_with(&path, compression).unwrap();
+            write_static(&mut bag, &sensors).unwrap();
+            for f in &frames {
+                write_frame(&mut bag, &f.cloud, &sensors, PcdLayout::Velodyne, f.start_time_s, &f.world_from_vehicle)
+                    .unwrap();
+            }
+            bag.finish().unwrap();
+            let b = Bag::open(&path).unwrap();
+            let messages: Vec<(String, u64, Vec<u8>)> = sensors
+                .iter()
+                .flat_map(|s| {
+                    b.clouds(&s.topic).unwrap().map(|c| {
+                        let c = c.unwrap();
+                        (s.topic.clone(), c.log_time_ns, c.cdr)
+                    })
+                })
+                .collect();
+            (messages, std::fs::metadata(path.join(format!("{name}_0.mcap"))).unwrap().len())
+        };
+        let (zstd, zstd_bytes) = write("zstd", crate::io::ros2::BagCompression::Zstd);
+        let (none, none_bytes) = write("none", crate::io::ros2::BagCompression::None);
+        assert_eq!(zstd.len(), 8, "2 frames x 4 sensors");
+        assert!(zstd == none, "the decoded messages differ between zstd and uncompressed bags");
+        assert!(zstd_bytes < none_bytes, "zstd {zstd_bytes} bytes, uncompressed {none_bytes}");
+        // Each message is the cloud's PCD body behind its PointCloud2 header, as written.
+        let rows = super::sensor_rows(&frames[0].cloud, 0);
+        let from = sensors[0].vehicle_from_sensor.inverse();
+        let pcd = encode_layout(&rows, PcdLayout::Velodyne, false, Some(&from)).unwrap();
+        let header = Header { stamp: Time::from_seconds(frames[0].start_time_s), frame_id: sensors[0].name.clone() };
+        let msg = from_pcd(&pcd, header).unwrap();
+        let expected = crate::io::ros2::messages::to_cdr(&msg, msg.data.len()).unwrap();
+        assert!(zstd[0].2 == expected, "the first cloud's CDR bytes differ from its PCD's");
+    }
 }
