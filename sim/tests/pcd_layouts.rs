@@ -152,3 +152,34 @@ fn reading_into_a_used_cloud_gives_what_a_fresh_one_gets() {
         assert_eq!(format!("{used:?}"), format!("{fresh:?}"), "{name} read into a larger used cloud");
     }
 }
+
+/// nebula's Hesai and RoboSense clouds name the laser `channel`: read as the ring (and `ring`
+/// wins where a file has both).
+#[test]
+fn nebula_channel_field_is_the_ring() {
+    let body: Vec<u8> = [(1.0f32, 2u16, 9u16), (2.0, 5, 11)]
+        .iter()
+        .flat_map(|&(x, channel, ring)| {
+            let mut rec = Vec::new();
+            for v in [x, 0.5, -1.0] {
+                rec.extend_from_slice(&v.to_le_bytes());
+            }
+            rec.extend_from_slice(&channel.to_le_bytes());
+            rec.extend_from_slice(&ring.to_le_bytes());
+            rec
+        })
+        .collect();
+    let file = |fields: &str| {
+        let mut f = format!(
+            "VERSION 0.7\nFIELDS {fields}\nSIZE 4 4 4 2 2\nTYPE F F F U U\nCOUNT 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA binary\n"
+        )
+        .into_bytes();
+        f.extend_from_slice(&body);
+        f
+    };
+    let (cloud, info) = read_bytes_with_info(Path::new("nebula.pcd"), &file("x y z channel other")).unwrap();
+    assert!(info.has_ring);
+    assert_eq!(cloud.ring, vec![2, 5]);
+    let (cloud, _) = read_bytes_with_info(Path::new("both.pcd"), &file("x y z channel ring")).unwrap();
+    assert_eq!(cloud.ring, vec![9, 11]);
+}

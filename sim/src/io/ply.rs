@@ -95,7 +95,7 @@ pub fn read_bytes_with_ring(path: &Path, bytes: &[u8]) -> Result<(OrderedCloud, 
         return Err(SimError::bad_file(path, "PLY `vertex` element lacks scalar x, y or z"));
     };
     let i_int = idx(&["intensity", "scalar_intensity", "reflectance"]);
-    let i_ring = idx(&["ring"]);
+    let i_ring = idx(&["ring", "channel"]);
     let i_time = idx(&["time", "timestamp"]);
     let i_label = idx(&["label", "class", "scalar_label"]);
     let i_inst = idx(&["instance"]);

@@ -35,7 +35,8 @@ pub(super) fn slot_of(name: &str) -> Option<Slot> {
         "y" => Slot::Y,
         "z" => Slot::Z,
         "intensity" => Slot::Intensity,
-        "ring" => Slot::Ring,
+        // `channel`: the laser's index in nebula's Hesai and RoboSense clouds (ROS 2 drivers).
+        "ring" | "channel" => Slot::Ring,
         "time" | "timestamp" | "t" => Slot::Time,
         "label" => Slot::Label,
         "instance" => Slot::Instance,
@@ -236,7 +237,9 @@ pub(crate) fn layout(
             (t, s) => return Err(bad(format!("PCD header: field `{}` has unsupported TYPE {t} SIZE {s}", f.name))),
         };
         if let Some(slot) = slot_of(&f.name) {
-            slots[slot as usize].get_or_insert(FieldPos { scalar, offset, token });
+            let pos = FieldPos { scalar, offset, token };
+            // The first field of a slot wins, but `ring` wins over its alias `channel`.
+            if f.name == "ring" { slots[slot as usize] = Some(pos) } else { slots[slot as usize].get_or_insert(pos); }
         }
         field_spans.push((offset, f.size * f.count));
         offset += f.size * f.count;
