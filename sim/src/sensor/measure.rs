@@ -117,3 +117,31 @@ pub fn validate_measurement(field: &str, m: &Measurement) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The detection figure is overridable and checked: a range in `(0, 10000]` m, a reflectance
+    /// in `(0, 1]`, each refused naming its field.
+    #[test]
+    fn the_detection_figure_is_overridden_and_checked() {
+        let base = Measurement::spinning(0.5, 120.0, 0.01, 0.001).with_detection(40.0, 0.1);
+        let params = MeasurementParams { detection_range_m: Some(45.0), ..Default::default() };
+        let m = params.apply(base);
+        assert_eq!((m.detection_range_m, m.detection_reflectance), (45.0, 0.1));
+        assert!(validate_measurement("s", &m).is_ok());
+        for (range_m, rho, field) in [
+            (0.0, 0.1, "s.detection_range_m"),
+            (f32::NAN, 0.1, "s.detection_range_m"),
+            (20_000.0, 0.1, "s.detection_range_m"),
+            (40.0, 0.0, "s.detection_reflectance"),
+            (40.0, 1.5, "s.detection_reflectance"),
+        ] {
+            let e = validate_measurement("s", &base.with_detection(range_m, rho)).unwrap_err().to_string();
+            assert!(e.contains(field), "{range_m} m at {rho}: {e}");
+        }
+        let toml: MeasurementParams = toml::from_str("detection_reflectance = 0.8").unwrap();
+        assert_eq!(toml.apply(base).detection_reflectance, 0.8);
+    }
+}
