@@ -2,7 +2,7 @@
 """Flakes per return mode: our snowfall seen by one roof sensor in its strongest, last and dual
 return modes (docs/weather.md, "Return modes").
 
-    python snow_return_modes.py [--bin target/debug/groundtruth] [--model pandar64]
+    python snow_return_modes.py [--bin target/debug/groundtruth] [--model pandar64 | all]
                                 [--modes strongest last dual] [--snow 1 3] [--scene rural]
                                 [--seeds 0 1] [--frames 2]
 
@@ -19,8 +19,9 @@ the standard library only. Per mode and rate it prints:
 * ``behind``: flakes in plane 0 with a surface (not a flake) in plane 1 of the same shot, as a
   share of the flakes (dual only).
 
-``--model os1-128`` (a built-in model without return modes) is scanned as it is and with
-``max_echoes = 2``, which the weather meets as dual (every echo, nearest first).
+The built-in models without return modes (``vlp16``, ``hdl64e``, ``os1-64``, ``os1-128``) are
+scanned as they are (``single``: strongest) and with ``max_echoes = 2`` (``two echoes``), which the
+weather meets as dual (every echo, nearest first). ``--model all`` runs every roof sensor in turn.
 """
 
 from __future__ import annotations
@@ -38,6 +39,14 @@ SNOW = 152
 # ring time label instance ground range sensor echo column nx ny nz.
 RECORD = struct.Struct("<ffffHdIIBfBBIfff")
 LABEL, RANGE = 6, 9
+
+# The models without catalogued return modes: one echo as they are, two with max_echoes = 2.
+BUILT_IN = ("vlp16", "hdl64e", "os1-64", "os1-128")
+# Every sensor of the `*-roof` presets (sim/src/rig/presets.rs).
+ROOF_MODELS = (
+    "vlp16", "hdl64e", "os1-64", "os1-128", "hdl32e", "vlp32c", "vls128", "os0-128", "os2-128", "pandar64",
+    "pandar-xt32", "rs-helios-5515",
+)
 
 RIG = """name = "{name}"
 
@@ -101,15 +110,22 @@ def main() -> int:
     ap.add_argument("--frames", type=int, default=2)
     ap.add_argument("--snow", type=float, nargs="+", default=[1.0, 3.0])
     args = ap.parse_args()
-    if args.model == "os1-128":
+    for model in ROOF_MODELS if args.model == "all" else [args.model]:
+        run(args, model)
+    return 0
+
+
+def run(args: argparse.Namespace, model: str) -> None:
+    """Every mode and rate of one model."""
+    if model in BUILT_IN:
         settings = {"single": "", "two echoes": "measurement = { max_echoes = 2 }"}
     else:
         settings = {mode: f'return_mode = "{mode}"' for mode in args.modes}
     with tempfile.TemporaryDirectory() as tmp:
         for rate in args.snow:
             for mode, setting in settings.items():
-                rig = Path(tmp) / f"{args.model}-{mode.replace(' ', '-')}.toml"
-                rig.write_text(RIG.format(name=rig.stem, model=args.model, setting=setting))
+                rig = Path(tmp) / f"{model}-{mode.replace(' ', '-')}.toml"
+                rig.write_text(RIG.format(name=rig.stem, model=model, setting=setting))
                 pcds = []
                 for seed in args.seeds:
                     out = Path(tmp) / f"{rig.stem}-{rate:g}-{seed}"
@@ -120,8 +136,7 @@ def main() -> int:
                     ]
                     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
                     pcds += sorted(out.glob("*.pcd"))
-                print(f"{args.model} {mode} snow {rate:g} mm/h: {count(pcds)}", flush=True)
-    return 0
+                print(f"{model} {mode} snow {rate:g} mm/h: {count(pcds)}", flush=True)
 
 
 if __name__ == "__main__":

@@ -69,6 +69,8 @@ mod tests {
             max_echoes: 1,
             echo_separation_m: 1.0,
             intensity_reference_m: 10.0,
+            detection_range_m: 100.0,
+            detection_reflectance: 0.1,
         }
     }
 

@@ -75,6 +75,8 @@ pub fn utm_measurement(params: &MeasurementParams) -> Measurement {
         max_echoes: 1,
         echo_separation_m: 1.0,
         intensity_reference_m: 5.0,
+        detection_range_m: 30.0,
+        detection_reflectance: 0.9,
     })
 }
 

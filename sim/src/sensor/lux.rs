@@ -326,6 +326,8 @@ impl LuxSpec {
             max_echoes: 3,
             echo_separation_m: 1.0,
             intensity_reference_m: 20.0,
+            detection_range_m: 50.0,
+            detection_reflectance: 0.1,
         })
     }
 }

@@ -53,7 +53,7 @@ fn validate_mode(field: &str, columns: u32, frequency_hz: f32) -> Result<()> {
 /// dropout beyond 89 deg, divergence 3 mrad (0.18 deg), one echo, echo separation 1 m, intensity
 /// reference 10 m.
 fn os1_measurement(params: &MeasurementParams) -> Measurement {
-    params.apply(Measurement::spinning(0.5, 120.0, 0.01, 0.001))
+    params.apply(Measurement::spinning(0.5, 120.0, 0.01, 0.001).with_detection(40.0, 0.1))
 }
 
 /// Lasers of a uniform-elevation OS1 from the top channel down; returned bottom-up (row order).

@@ -70,13 +70,36 @@ pub struct Measurement {
     pub echo_separation_m: f32,
     /// Range at which a reflectivity-1 target at normal incidence saturates intensity, metres.
     pub intensity_reference_m: f32,
+    /// The datasheet's detection figure, its range: a Lambertian target of
+    /// [`Measurement::detection_reflectance`] at normal incidence is detected out to this range in
+    /// clear air, metres. With it the sensor's detection threshold (weather) is
+    /// `detection_reflectance (intensity_reference_m / detection_range_m)^2`
+    /// (`crate::effects::weather::detection_threshold`). Each model's figure and its source:
+    /// docs/sensors.md, "Detection figures". Not a range gate: [`Measurement::max_range_m`] is.
+    #[serde(default = "default_detection_range_m")]
+    pub detection_range_m: f32,
+    /// The datasheet's detection figure, its target's reflectance, `(0, 1]` (0.1 = a 10 % target).
+    #[serde(default = "default_detection_reflectance")]
+    pub detection_reflectance: f32,
+}
+
+/// Manifests written before the detection figure existed: the custom model's default (100 m).
+fn default_detection_range_m() -> f32 {
+    100.0
+}
+
+/// Manifests written before the detection figure existed: a 10 % target.
+fn default_detection_reflectance() -> f32 {
+    0.1
 }
 
 impl Measurement {
     /// A spinning sensor's measurement from its range limits, range noise and range quantum, with
     /// the figures every spinning model here shares (representative, not from a datasheet): grazing
     /// returns beyond 89 deg dropped, 3 mrad beam divergence, one echo (a return mode with two
-    /// sets [`Measurement::max_echoes`]), 1 m echo separation, intensity saturating at 10 m.
+    /// sets [`Measurement::max_echoes`]), 1 m echo separation, intensity saturating at 10 m, and
+    /// the detection figure "a 10 % target out to `max_range_m`" until
+    /// [`Measurement::with_detection`] sets the datasheet's.
     pub const fn spinning(min_range_m: f32, max_range_m: f32, range_sigma_m: f32, range_quantum_m: f32) -> Self {
         Self {
             min_range_m,
@@ -88,7 +111,15 @@ impl Measurement {
             max_echoes: 1,
             echo_separation_m: 1.0,
             intensity_reference_m: 10.0,
+            detection_range_m: max_range_m,
+            detection_reflectance: 0.1,
         }
+    }
+
+    /// This measurement with the datasheet's detection figure: a target of `reflectance` (0.1 = a
+    /// 10 % Lambertian target) detected out to `range_m`.
+    pub const fn with_detection(self, range_m: f32, reflectance: f32) -> Self {
+        Self { detection_range_m: range_m, detection_reflectance: reflectance, ..self }
     }
 
     /// This measurement with every effect off: exact distances, no noise, no quantisation,

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::measure::{MeasurementParams, validate_measurement};
+use super::measure::{MeasurementParams, UNSTATED_DETECTION_REFLECTANCE, validate_measurement};
 use super::spinning::{Laser, columns_per_revolution, spinning_pattern};
 use super::{Measurement, ScanPattern};
 use crate::error::{Result, check_range};
@@ -74,7 +74,8 @@ impl Vlp16Spec {
 
     /// The default measurement with overrides applied.
     pub fn measurement(&self) -> Measurement {
-        self.measurement.apply(Measurement::spinning(0.5, 100.0, 0.03, 0.002))
+        self.measurement
+            .apply(Measurement::spinning(0.5, 100.0, 0.03, 0.002).with_detection(100.0, UNSTATED_DETECTION_REFLECTANCE))
     }
 }
 
@@ -179,6 +180,8 @@ impl Hdl64eSpec {
             max_echoes: 1,
             echo_separation_m: 1.0,
             intensity_reference_m: 12.0,
+            detection_range_m: 50.0,
+            detection_reflectance: 0.1,
         })
     }
 }

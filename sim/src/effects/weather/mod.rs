@@ -6,7 +6,9 @@
 //! ([`crate::effects::measure`]) a return of reflectance `rho cos(theta)` at range `R` has the
 //! power `P = rho cos(theta) (r_ref / R)^2` (unsaturated), and the sensor detects it when
 //! `P >= P_min`, its detection threshold: `P_min = 0.1 (r_ref / max_range)^2`, a 10 % target at
-//! normal incidence seen out to the sensor's maximum range in clear air. The medium attenuates a
+//! normal incidence seen out to the sensor's maximum range in clear air ([`range_gate_threshold`];
+//! each sensor's threshold by its datasheet, [`detection_threshold`], is carried but not applied:
+//! docs/weather.md, "Detection thresholds by datasheet"). The medium attenuates a
 //! hard target twice (out and back), `T^2 = exp(-2 alpha R)`, and adds returns of its own; the
 //! sensor reports the strongest detectable return of the beam, as single-return units do in their
 //! strongest mode (other modes: "Return modes" below):
@@ -189,9 +191,21 @@ impl Weather {
     }
 }
 
-/// The detection threshold of a sensor in the intensity model's power units:
-/// `0.1 (r_ref / max_range)^2` (module docs).
+/// The detection threshold of a sensor by its datasheet, in the intensity model's power units: the
+/// datasheet's target seen out to the datasheet's range, `rho_spec (r_ref / R_spec)^2`
+/// ([`Measurement::detection_reflectance`], [`Measurement::detection_range_m`]; docs/sensors.md,
+/// "Detection figures"). Not yet the weather's threshold: with it every sensor but the Pandar64
+/// sees almost no snow under the receiver calibrated on WADS, and no receiver geometry brings the
+/// OS1-128 back to WADS's median range (docs/weather.md, "Detection thresholds by datasheet").
 pub fn detection_threshold(m: &Measurement) -> f32 {
+    m.detection_reflectance * (m.intensity_reference_m / m.detection_range_m).powi(2)
+}
+
+/// The threshold the weather applies (module docs): `0.1 (r_ref / max_range)^2`, a 10 % target
+/// at normal incidence out to the range gate, the rule with which fog's constants were taken from
+/// Hahner et al. and snow's receiver was fitted to WADS. It equals [`detection_threshold`] only
+/// where the datasheet's figure is a 10 % target at `max_range_m` (the Pandar64).
+pub fn range_gate_threshold(m: &Measurement) -> f32 {
     0.1 * (m.intensity_reference_m / m.max_range_m).powi(2)
 }
 
@@ -278,7 +292,7 @@ impl SensorWeather {
                 Medium::Particles(Arc::new(particles::ParticleTable::new(&particles::Particles::snow(rate_mm_h), m)))
             }
         };
-        Self { alpha_per_m, p_min: detection_threshold(m), m: *m, medium, mode: ReturnMode::Strongest }
+        Self { alpha_per_m, p_min: range_gate_threshold(m), m: *m, medium, mode: ReturnMode::Strongest }
     }
 
     /// This weather for a sensor reporting in `mode` (module docs; [`SensorWeather::new`] gives
@@ -414,6 +428,42 @@ mod tests {
         );
         assert_eq!(w.beam(Some((100.0, 0.05 * (12.0f32 / 100.0).powi(2))), &key), BeamOutcome::Lost);
         assert_eq!(w.beam(None, &key), BeamOutcome::Lost);
+    }
+
+    /// Each sensor's threshold by its datasheet (docs/sensors.md, "Detection figures"): a target of
+    /// the datasheet's reflectance at the datasheet's range is right on it, one a little dimmer or
+    /// farther is below it; the weather's threshold is the range-gate rule, equal to it only for
+    /// the Pandar64 (200 m at 10 %).
+    #[test]
+    fn datasheet_thresholds_put_the_datasheet_target_on_the_threshold() {
+        let measurement = |rig: &str| crate::Rig::load(rig).unwrap().sensors[0].spec.measurement();
+        // (rig, range m, reflectance): HDL-64E 50 m at 10 %, OS1 40 m at 10 %, Pandar64 200 m at
+        // 10 %, PandarXT-32 80 m at 10 %, LUX 50 m at 10 %, the unstated Velodyne and Ouster
+        // ranges at 80 %.
+        for (rig, range_m, rho) in [
+            ("hdl64e-roof", 50.0f32, 0.1f32),
+            ("os1-128-roof", 40.0, 0.1),
+            ("os1-64-roof", 40.0, 0.1),
+            ("pandar64-roof", 200.0, 0.1),
+            ("pandar-xt32-roof", 80.0, 0.1),
+            ("lux-roof-4", 50.0, 0.1),
+            ("vlp16-roof", 100.0, 0.8),
+            ("hdl32e-roof", 100.0, 0.8),
+            ("vls128-roof", 245.0, 0.8),
+            ("os2-128-roof", 240.0, 0.8),
+        ] {
+            let m = measurement(rig);
+            let p = detection_threshold(&m);
+            let power = |rho: f32, r: f32| rho * (m.intensity_reference_m / r).powi(2);
+            assert!((power(rho, range_m) / p - 1.0).abs() < 1e-5, "{rig}: {p} vs {}", power(rho, range_m));
+            assert!(power(rho, 1.01 * range_m) < p && power(0.99 * rho, range_m) < p, "{rig}");
+        }
+        let pandar = measurement("pandar64-roof");
+        assert_eq!(detection_threshold(&pandar), range_gate_threshold(&pandar));
+        // The HDL-64E's datasheet threshold is (120 / 50)^2 = 5.76 times the range-gate rule's.
+        let hdl = hdl();
+        assert!((detection_threshold(&hdl) / range_gate_threshold(&hdl) - 5.76).abs() < 1e-4);
+        assert_eq!(SensorWeather::new(&Weather::Snow { rate_mm_h: 1.0 }, &hdl).threshold(), range_gate_threshold(&hdl));
     }
 
     /// With fog, the largest range at which a target of reflectance `rho` is detected solves

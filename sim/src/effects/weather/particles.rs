@@ -222,7 +222,7 @@ impl ParticleTable {
     pub fn new(particles: &Particles, m: &Measurement) -> Self {
         let mut t = Self {
             particles: *particles,
-            p_min: f64::from(super::detection_threshold(m)),
+            p_min: f64::from(super::range_gate_threshold(m)),
             r_ref: f64::from(m.intensity_reference_m),
             alpha: particles.extinction_per_m(),
             divergence_rad: f64::from(m.beam_divergence_rad),

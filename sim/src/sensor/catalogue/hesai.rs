@@ -101,7 +101,7 @@ pub const PANDAR64: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: PANDAR64_CYCLE_NS },
     rates_hz: &[10.0, 20.0],
     default_rate_hz: 10.0,
-    measurement: measurement(0.3, 200.0, 0.02),
+    measurement: measurement(0.3, 200.0, 0.02).with_detection(200.0, 0.1),
     return_modes: &RETURN_MODES,
     driver: NEBULA_DRIVER,
 };
@@ -147,7 +147,7 @@ pub const PANDAR_XT32: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: 50_000 },
     rates_hz: &[5.0, 10.0, 20.0],
     default_rate_hz: 10.0,
-    measurement: measurement(0.05, 120.0, 0.01),
+    measurement: measurement(0.05, 120.0, 0.01).with_detection(80.0, 0.1),
     return_modes: &RETURN_MODES,
     driver: NEBULA_DRIVER,
 };

@@ -11,6 +11,7 @@
 
 use super::{CatalogueEntry, ColumnRule, DriverLayout, PointOrder, ReturnMode, RingNumbering};
 use crate::sensor::Measurement;
+use crate::sensor::measure::UNSTATED_DETECTION_REFLECTANCE;
 
 const MODES: [(u32, &[f32]); 3] = [(512, &[10.0, 20.0]), (1024, &[10.0, 20.0]), (2048, &[10.0])];
 
@@ -97,7 +98,7 @@ pub const OS0_128: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::Modes { modes: &MODES, default_columns: 1024 },
     rates_hz: &[10.0, 20.0],
     default_rate_hz: 10.0,
-    measurement: measurement(0.5, 75.0),
+    measurement: measurement(0.5, 75.0).with_detection(75.0, UNSTATED_DETECTION_REFLECTANCE),
     return_modes: &RETURN_MODES,
     driver: DRIVER,
 };
@@ -156,7 +157,7 @@ pub const OS2_128: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::Modes { modes: &MODES, default_columns: 1024 },
     rates_hz: &[10.0, 20.0],
     default_rate_hz: 10.0,
-    measurement: measurement(0.5, 240.0),
+    measurement: measurement(0.5, 240.0).with_detection(240.0, UNSTATED_DETECTION_REFLECTANCE),
     return_modes: &RETURN_MODES,
     driver: DRIVER,
 };

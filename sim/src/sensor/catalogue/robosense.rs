@@ -11,6 +11,7 @@
 use super::hesai::NEBULA_DRIVER;
 use super::{CatalogueEntry, ColumnRule, ReturnMode};
 use crate::sensor::Measurement;
+use crate::sensor::measure::UNSTATED_DETECTION_REFLECTANCE;
 
 /// Helios elevations by channel, degrees (+14.94 ..= -54.6).
 #[rustfmt::skip]
@@ -48,7 +49,7 @@ pub const HELIOS_5515: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: 55_560 },
     rates_hz: &[10.0, 20.0],
     default_rate_hz: 10.0,
-    measurement: Measurement::spinning(0.2, 150.0, 0.02, 0.0025),
+    measurement: Measurement::spinning(0.2, 150.0, 0.02, 0.0025).with_detection(150.0, UNSTATED_DETECTION_REFLECTANCE),
     return_modes: &[ReturnMode::Strongest, ReturnMode::Last, ReturnMode::Dual],
     driver: NEBULA_DRIVER,
 };

@@ -13,6 +13,7 @@
 
 use super::{CatalogueEntry, ColumnRule, DriverLayout, PointOrder, ReturnMode, RingNumbering};
 use crate::sensor::Measurement;
+use crate::sensor::measure::UNSTATED_DETECTION_REFLECTANCE;
 
 /// 5 ..= 20 Hz in whole hertz (300 ..= 1200 rpm in steps of 60).
 const RATES_HZ: [f32; 16] = [5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 13.0, 14.0, 15.0, 16.0, 17.0, 18.0, 19.0, 20.0];
@@ -80,7 +81,7 @@ pub const HDL32E: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: 46_080 },
     rates_hz: &RATES_HZ,
     default_rate_hz: 10.0,
-    measurement: measurement(0.9, 100.0, 0.02, 0.002),
+    measurement: measurement(0.9, 100.0, 0.02, 0.002).with_detection(100.0, UNSTATED_DETECTION_REFLECTANCE),
     return_modes: &RETURN_MODES,
     driver: DRIVER,
 };
@@ -116,7 +117,7 @@ pub const VLP32C: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: 55_296 },
     rates_hz: &RATES_HZ,
     default_rate_hz: 10.0,
-    measurement: measurement(0.9, 200.0, 0.03, 0.004),
+    measurement: measurement(0.9, 200.0, 0.03, 0.004).with_detection(200.0, UNSTATED_DETECTION_REFLECTANCE),
     return_modes: &RETURN_MODES,
     driver: DRIVER,
 };
@@ -177,7 +178,7 @@ pub const VLS128: CatalogueEntry = CatalogueEntry {
     columns: ColumnRule::FiringCycle { cycle_ns: 53_300 },
     rates_hz: &RATES_HZ,
     default_rate_hz: 10.0,
-    measurement: measurement(0.9, 245.0, 0.03, 0.004),
+    measurement: measurement(0.9, 245.0, 0.03, 0.004).with_detection(245.0, UNSTATED_DETECTION_REFLECTANCE),
     return_modes: &RETURN_MODES,
     driver: DRIVER,
 };
