@@ -239,7 +239,11 @@ pub(crate) fn layout(
         if let Some(slot) = slot_of(&f.name) {
             let pos = FieldPos { scalar, offset, token };
             // The first field of a slot wins, but `ring` wins over its alias `channel`.
-            if f.name == "ring" { slots[slot as usize] = Some(pos) } else { slots[slot as usize].get_or_insert(pos); }
+            if f.name == "ring" {
+                slots[slot as usize] = Some(pos)
+            } else {
+                slots[slot as usize].get_or_insert(pos);
+            }
         }
         field_spans.push((offset, f.size * f.count));
         offset += f.size * f.count;
