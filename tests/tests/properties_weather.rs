@@ -184,11 +184,7 @@ proptest! {
 
 /// Ground recall of `method` on `scene` (HDL-64E on the roof) in clear air and in `weather`.
 fn recalls(scene: &str, seed: u64, weather: Weather, method: &str) -> (f64, f64) {
-    let s = Scenario::bundled(scene).rig("hdl64e-roof").seed(seed);
-    let r = |w: Weather| s.clone().weather(w).scan().unwrap().score_method(method, &Region::Ground).unwrap().recall();
-    let (clear, wet) = (r(Weather::Clear), r(weather));
-    eprintln!("{method} {scene} seed {seed} {}: ground recall {clear:.4} clear, {wet:.4}", weather.spec());
-    (clear, wet)
+    recalls_with("hdl64e-roof", scene, seed, weather, method)
 }
 
 /// Known failure: fog of 166 m visibility returns nothing of its own but attenuates the far ground

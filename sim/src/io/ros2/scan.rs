@@ -134,12 +134,18 @@ mod tests {
     use super::*;
     use crate::io::ros2::Bag;
 
-    #[test]
-    fn a_scan_becomes_a_bag_with_one_cloud_per_frame_and_sensor() {
+    /// Two ideal frames of the four-sensor LUX rig on `flat`, at 5 m/s.
+    fn two_lux_frames() -> (crate::Rig, Vec<crate::scan::Frame>) {
         let mesh = crate::scene::builtin::flat();
         let rig = crate::Rig::load("lux-roof-4").unwrap();
         let config = crate::scan::ScanConfig { frames: 2, ideal: true, speed_m_per_s: 5.0, ..Default::default() };
         let frames = crate::scan::scan(&mesh, &rig, &config).unwrap();
+        (rig, frames)
+    }
+
+    #[test]
+    fn a_scan_becomes_a_bag_with_one_cloud_per_frame_and_sensor() {
+        let (rig, frames) = two_lux_frames();
         let dir = tempfile::tempdir().unwrap();
         let sensors = sensor_topics(&rig);
         for layout in [PcdLayout::Groundtruth, PcdLayout::Velodyne] {
@@ -169,10 +175,7 @@ mod tests {
     /// bytes at the same times, what an uncompressed scan writes; the zstd file is the smaller.
     #[test]
     fn compressed_and_uncompressed_bags_hold_the_same_messages() {
-        let mesh = crate::scene::builtin::flat();
-        let rig = crate::Rig::load("lux-roof-4").unwrap();
-        let config = crate::scan::ScanConfig { frames: 2, ideal: true, speed_m_per_s: 5.0, ..Default::default() };
-        let frames = crate::scan::scan(&mesh, &rig, &config).unwrap();
+        let (rig, frames) = two_lux_frames();
         let dir = tempfile::tempdir().unwrap();
         let sensors = sensor_topics(&rig);
         let write = |name: &str, compression| {
