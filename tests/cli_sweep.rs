@@ -154,7 +154,8 @@ pitch_deg = [-2.0, -1.0, 0.0, 1.0, 2.0]
         .unwrap();
     let csv = out.join("results.csv");
     loop {
-        let n = std::fs::read_to_string(&csv).map(|t| t.lines().count()).unwrap_or(0);
+        // Whole lines only: the last one may be half written when it is read.
+        let n = std::fs::read_to_string(&csv).map(|t| t.matches('\n').count()).unwrap_or(0);
         if n > 10 {
             break;
         }
