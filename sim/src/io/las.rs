@@ -135,6 +135,10 @@ pub fn write_with(path: &Path, cloud: &OrderedCloud, compressed: bool) -> Result
     Ok(n)
 }
 
+/// The largest ratio of a LAZ file's point records to its size accepted (LASzip compresses point
+/// records about 5 to 10 times).
+const LAZ_MAX_RATIO: u64 = 64;
+
 /// Reads a LAS file (ours or another tool's) into a `1 x N` cloud in file order, the inverse of
 /// [`encode`] for our files: `x y z` (vehicle frame for ours; within the 0.1 mm scale), intensity
 /// / 65535, `echo` = return number - 1, `time_s` = GPS time (0 without), `label` = `user_data`
@@ -144,6 +148,22 @@ pub fn write_with(path: &Path, cloud: &OrderedCloud, compressed: bool) -> Result
 /// A malformed file is an error naming it.
 pub fn read(path: &Path) -> Result<OrderedCloud> {
     let mut reader = las::Reader::from_path(path).map_err(|e| las_err(path, e))?;
+    // The header's point count must fit the file: `read_all` reserves what the header declares,
+    // so a 300-byte file declaring billions of points would allocate gigabytes (found by the
+    // `las` fuzz target). LAZ: up to `LAZ_MAX_RATIO` times smaller than its records.
+    let file_len = std::fs::metadata(path).map_err(|e| SimError::io(path, e))?.len();
+    let (declared, format) = (reader.header().number_of_points(), *reader.header().point_format());
+    let record = u64::from(format.len()).max(1);
+    let holds = if format.is_compressed { file_len.saturating_mul(LAZ_MAX_RATIO) } else { file_len } / record;
+    if declared > holds {
+        return Err(SimError::bad_file(
+            path,
+            format!(
+                "LAS header: number of point records {declared} is more than the file's {file_len} bytes \
+                 can hold ({holds} records of {record} bytes)"
+            ),
+        ));
+    }
     let data = reader.read_all().map_err(|e| las_err(path, e))?;
     let n = data.len();
     let mut c = OrderedCloud::empty(1, n, 1);
@@ -202,6 +222,14 @@ mod tests {
             assert_eq!(r.time_s[j], c.time_s[i]);
             assert!((r.intensity[j] - 0.5).abs() < 1e-4);
         }
+        // A header declaring more points than the file holds is refused before anything is
+        // reserved (the legacy 32-bit point count at byte 107, LAS 1.4's 64-bit one at 247).
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
+        bytes[247..255].copy_from_slice(&1_000_000_000_000u64.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(e.contains("number of point records") && e.contains("x.las"), "{e}");
         std::fs::write(&path, b"LASF truncated").unwrap();
         assert!(read(&path).unwrap_err().to_string().contains("x.las"));
     }
