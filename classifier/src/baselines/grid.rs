@@ -162,7 +162,6 @@ impl GridAccumulation {
                 s.z_count += 1;
             }
         }
-        let isolated = |i: usize| self.isolated.get(i).copied().unwrap_or(false);
         let mut out: Vec<bool> =
             self.world.iter().enumerate().map(|(i, &p)| is_valid(p) && !isolated(i) && self.is_ground(p)).collect();
         if self.params.cluster {
