@@ -23,7 +23,8 @@ The measurements it is read beside (``docs/weather.md``, "Calibrated on measurem
   (6.7 % on average), median range 6.5-6.9 m, almost none closer than 3 m, under 1 % beyond
   14 m; by range 76 % of returns at 2-4 m, 70 % at 4-6, 45 % at 6-8, 13 % at 8-10; near-horizontal
   beams 11.5 %, beams below -6 deg 0.9 % (figures of issue 45, measured on the public labels);
-* rain: the study named in docs/weather.md (false returns per rain rate).
+* rain: Linnhoff et al. 2022 (docs/weather.md; the per-beam comparison is
+  ``rain_vs_measured.py``).
 
 Prints one JSON object.
 """
@@ -54,22 +55,31 @@ RANGE_BINS_M = [(0, 2), (2, 4), (4, 6), (6, 8), (8, 10), (10, 14), (14, 1e9)]
 ELEVATION_BINS_DEG = [(-90, -6), (-6, -2), (-2, 2), (2, 6), (6, 90)]
 
 
-def read_pcd(path: Path) -> np.ndarray:
-    """The returns of one organized PCD of ours (no-return cells, NaN x, dropped)."""
+def read_cells(path: Path) -> np.ndarray:
+    """Every cell of one organized PCD of ours, no-return cells (NaN x) included."""
     data = path.read_bytes()
     end = data.index(b"DATA binary\n") + len(b"DATA binary\n")
-    rec = np.frombuffer(data[end:], dtype=RECORD)
+    return np.frombuffer(data[end:], dtype=RECORD)
+
+
+def read_pcd(path: Path) -> np.ndarray:
+    """The returns of one organized PCD of ours (no-return cells, NaN x, dropped)."""
+    rec = read_cells(path)
     return rec[np.isfinite(rec["x"])]
 
 
-def scan(binary: str, scene: str, rig: str, weather: str, seed: int, frames: int, out: Path) -> np.ndarray:
-    """All returns of a scan (every frame) as one record array."""
+def scan(
+    binary: str, scene: str, rig: str, weather: str, seed: int, frames: int, out: Path,
+    speed_m_per_s: float = 10.0, cells: bool = False,
+) -> np.ndarray:
+    """All returns of a scan (every frame) as one record array; every cell when ``cells``."""
     cmd = [
         binary, "scan", "--scene", scene, "--rig", rig, "--seed", str(seed), "--frames", str(frames),
-        "--speed-m-per-s", "10", "--weather", weather, "--format", "pcd", "--out", str(out),
+        "--speed-m-per-s", f"{speed_m_per_s:g}", "--weather", weather, "--format", "pcd", "--out", str(out),
     ]
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    return np.concatenate([read_pcd(p) for p in sorted(out.glob("*.pcd"))])
+    read = read_cells if cells else read_pcd
+    return np.concatenate([read(p) for p in sorted(out.glob("*.pcd"))])
 
 
 def stats(points: np.ndarray, label: int) -> dict:

@@ -24,7 +24,8 @@
 //!   `rho_p min(1, A(D) / A_beam(R)) (r_ref / R)^2 xi(R) T^2(R)` (its backscatter cross-section
 //!   from its projected area and lidar ratio, the receiver's bistatic overlap `xi`) and the
 //!   medium's extinction follows from the same distribution ([`particles`]). Snow is calibrated
-//!   on WADS's labelled snowfall and accepted up to [`SNOW_CALIBRATED_MAX_MM_H`].
+//!   on WADS's labelled snowfall and accepted up to [`SNOW_CALIBRATED_MAX_MM_H`]; rain's drops'
+//!   backscatter on a VLP-16's rain detections in natural rain (Linnhoff et al. 2022).
 //!
 //! `clear` applies the detection threshold without a medium: the reference a weather scan is
 //! compared with. Returns from the medium get their own classes ([`SemanticClass::FOG`],
