@@ -187,10 +187,8 @@ fn save(figure: &impl Figure, path: &Path) -> anyhow::Result<()> {
             let (w, h) = SIZE;
             let mut rgb = vec![0u8; (w * h * 3) as usize];
             figure.draw_on(BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area())?;
-            let img = image::RgbImage::from_raw(w, h, rgb).context("plot buffer size")?;
-            let mut png = Vec::new();
-            img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).context("encoding the PNG")?;
-            png
+            let img = sim::picture::Raster::from_raw(w, h, rgb).context("plot buffer size")?;
+            img.to_png().context("encoding the PNG")?
         }
         Some("svg") => {
             let mut svg = String::new();

@@ -3,7 +3,6 @@
 
 use glam::Vec3;
 use sim::Rig;
-use sim::cast::Backend;
 use sim::scan::{ScanConfig, Scanner, scan};
 use sim::scene::builtin;
 
@@ -155,14 +154,16 @@ fn a_moving_vehicle_shows_motion_distortion_and_poses() {
     assert_ne!(still.cloud.returns(), 0);
 }
 
+#[cfg(feature = "reference")]
 #[test]
 fn the_reference_backend_gives_the_same_ideal_scan() {
     let mesh = builtin::flat_objects();
     let rig = Rig::preset("lux").unwrap();
     let a = &scan(&mesh, &rig, &ScanConfig { ideal: true, ..ScanConfig::default() }).unwrap()[0].cloud;
-    let b = &scan(&mesh, &rig, &ScanConfig { ideal: true, backend: Backend::Parry, ..ScanConfig::default() }).unwrap()
-        [0]
-    .cloud;
+    let b =
+        &scan(&mesh, &rig, &ScanConfig { ideal: true, backend: sim::cast::Backend::Parry, ..ScanConfig::default() })
+            .unwrap()[0]
+            .cloud;
     assert_eq!(a.returns(), b.returns());
     for i in 0..a.len() {
         if a.has_return(i) {

@@ -20,7 +20,12 @@ pub fn run(_args: Args) -> anyhow::Result<()> {
         println!("  {name}");
     }
     println!("casting backends:");
-    println!("  bvh (production), parry (reference)");
+    println!("  bvh (production)");
+    if sim::cast::REFERENCE_BUILT {
+        println!("  parry (reference)");
+    } else {
+        println!("  parry (reference): {}", sim::cast::REFERENCE_NOT_BUILT);
+    }
     match sim::cast::gpu_adapter() {
         Ok(adapter) => println!("  gpu: {adapter}"),
         Err(e) => println!("  gpu: unavailable: {e}"),

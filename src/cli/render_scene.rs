@@ -6,12 +6,10 @@
 //! non-ground covers the ego from above (a garage ceiling), the picture is a floor plan cut
 //! [`CUT_ABOVE_EGO_M`] above the ego's ground: triangles entirely above it are left out.
 
-use std::io::Cursor;
-
 use anyhow::Context;
 use font8x8::UnicodeFonts;
 use glam::Vec3;
-use image::{Rgb, RgbImage};
+use sim::picture::Raster;
 use sim::{SceneMesh, SemanticClass};
 
 /// Height of the floor-plan cut above the ego's ground for indoor scenes, metres.
@@ -22,9 +20,9 @@ const MAP_PX: u32 = 1200;
 const LEGEND_PX: u32 = 300;
 /// Text scale (8x8 glyphs drawn at 2x).
 const TEXT_SCALE: u32 = 2;
-const WHITE: Rgb<u8> = Rgb([255, 255, 255]);
-const BLACK: Rgb<u8> = Rgb([0, 0, 0]);
-const BACKGROUND: Rgb<u8> = Rgb([24, 24, 24]);
+const WHITE: [u8; 3] = [255, 255, 255];
+const BLACK: [u8; 3] = [0, 0, 0];
+const BACKGROUND: [u8; 3] = [24, 24, 24];
 
 /// Draws the picture.
 pub fn run(args: &super::render::Args) -> anyhow::Result<()> {
@@ -38,8 +36,7 @@ pub fn run(args: &super::render::Args) -> anyhow::Result<()> {
         title.push(format!("cut at {CUT_ABOVE_EGO_M} m"));
     }
     let img = draw(&scene.mesh, &title, cut_z)?;
-    let mut png = Vec::new();
-    img.write_to(&mut Cursor::new(&mut png), image::ImageFormat::Png).context("encoding PNG")?;
+    let png = img.to_png().context("encoding PNG")?;
     sim::io::atomic::write_bytes_atomic(&args.out, &png)?;
     eprintln!("wrote {} ({}x{} px, {} triangles)", args.out.display(), img.width(), img.height(), scene.mesh.len());
     Ok(())
@@ -60,7 +57,7 @@ fn covered_from_above(mesh: &SceneMesh, ego_z: f32) -> bool {
 
 /// Renders `mesh` from above with a legend titled by the `title` lines, leaving out triangles
 /// entirely above `cut_z`.
-fn draw(mesh: &SceneMesh, title: &[String], cut_z: Option<f32>) -> anyhow::Result<RgbImage> {
+fn draw(mesh: &SceneMesh, title: &[String], cut_z: Option<f32>) -> anyhow::Result<Raster> {
     let (lo, hi) = mesh.bounds().context("the scene is empty")?;
     let extent = (hi - lo).truncate().max_element().max(1.0);
     let m_per_px = extent / MAP_PX as f32;
@@ -68,7 +65,7 @@ fn draw(mesh: &SceneMesh, title: &[String], cut_z: Option<f32>) -> anyhow::Resul
     // Pixel (col, row) centre in world: x = hi.x - (row + 0.5) m, y = hi.y - (col + 0.5) m.
     let to_px = |p: Vec3| ((hi.y - p.y) / m_per_px, (hi.x - p.x) / m_per_px);
     let mut zbuf = vec![f32::NEG_INFINITY; (w * h) as usize];
-    let mut img = RgbImage::from_pixel(w + LEGEND_PX, h.max(300), BACKGROUND);
+    let mut img = Raster::from_pixel(w + LEGEND_PX, h.max(300), BACKGROUND);
     let light = Vec3::new(0.4, 0.3, 1.0).normalize();
     let mut present = std::collections::BTreeSet::new();
     let mut walls = Vec::new();
@@ -108,7 +105,7 @@ fn draw(mesh: &SceneMesh, title: &[String], cut_z: Option<f32>) -> anyhow::Resul
                 let k = (row * w + col) as usize;
                 if z > zbuf[k] {
                     zbuf[k] = z;
-                    img.put_pixel(col, row, Rgb(c));
+                    img.put_pixel(col, row, c);
                 }
             }
         }
@@ -116,7 +113,7 @@ fn draw(mesh: &SceneMesh, title: &[String], cut_z: Option<f32>) -> anyhow::Resul
     for i in walls {
         let tri = mesh.triangle(i);
         let top = tri.iter().map(|v| v.z).fold(f32::MIN, f32::max);
-        let c = Rgb(mesh.surfaces[i].class.color().map(|v| (f32::from(v) * 0.8) as u8));
+        let c = mesh.surfaces[i].class.color().map(|v| (f32::from(v) * 0.8) as u8);
         for (p, q) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
             let ((x0, y0), (x1, y1)) = (to_px(p), to_px(q));
             let steps = (x1 - x0).abs().max((y1 - y0).abs()).ceil() as u32 + 1;
@@ -140,7 +137,7 @@ fn draw(mesh: &SceneMesh, title: &[String], cut_z: Option<f32>) -> anyhow::Resul
 }
 
 /// A white arrow (4.5 m long, at least 12 px) at the ego origin pointing along +x (up).
-fn draw_ego(img: &mut RgbImage, (cx, cy): (f32, f32), m_per_px: f32) {
+fn draw_ego(img: &mut Raster, (cx, cy): (f32, f32), m_per_px: f32) {
     let len = (4.5 / m_per_px).max(12.0);
     for t in 0..len as i32 {
         let half_width = (len - t as f32) * 0.35;
@@ -151,7 +148,7 @@ fn draw_ego(img: &mut RgbImage, (cx, cy): (f32, f32), m_per_px: f32) {
 }
 
 /// A scale bar of a round length (about a fifth of the map width) with its label, bottom left.
-fn draw_scale_bar(img: &mut RgbImage, map_h: u32, m_per_px: f32) {
+fn draw_scale_bar(img: &mut Raster, map_h: u32, m_per_px: f32) {
     let target = 0.2 * MAP_PX as f32 * m_per_px;
     let len_m = [1.0f32, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0]
         .into_iter()
@@ -169,7 +166,7 @@ fn draw_scale_bar(img: &mut RgbImage, map_h: u32, m_per_px: f32) {
 }
 
 /// The legend panel right of the map: title, then one colour swatch and name per class present.
-fn draw_legend(img: &mut RgbImage, map_w: u32, title: &[String], present: &std::collections::BTreeSet<SemanticClass>) {
+fn draw_legend(img: &mut Raster, map_w: u32, title: &[String], present: &std::collections::BTreeSet<SemanticClass>) {
     let x0 = map_w as i32 + 12;
     let max_chars = ((LEGEND_PX - 16) / (8 * TEXT_SCALE)) as usize;
     let mut y = 12;
@@ -180,10 +177,10 @@ fn draw_legend(img: &mut RgbImage, map_w: u32, title: &[String], present: &std::
     }
     y += 12;
     for (ground, heading) in [(true, "ground"), (false, "non-ground")] {
-        draw_text(img, x0, y, heading, Rgb([180, 180, 180]));
+        draw_text(img, x0, y, heading, [180, 180, 180]);
         y += 22;
         for class in present.iter().filter(|c| c.is_ground() == ground) {
-            fill_rect(img, x0, y, 16, 16, Rgb(class.color()));
+            fill_rect(img, x0, y, 16, 16, class.color());
             draw_text(img, x0 + 24, y, class.name(), WHITE);
             y += 22;
         }
@@ -192,7 +189,7 @@ fn draw_legend(img: &mut RgbImage, map_w: u32, title: &[String], present: &std::
 }
 
 /// Draws `text` with the 8x8 font at `TEXT_SCALE`, top-left corner at `(x, y)`.
-fn draw_text(img: &mut RgbImage, x: i32, y: i32, text: &str, color: Rgb<u8>) {
+fn draw_text(img: &mut Raster, x: i32, y: i32, text: &str, color: [u8; 3]) {
     let s = TEXT_SCALE as i32;
     for (k, ch) in text.chars().enumerate() {
         let Some(glyph) = font8x8::BASIC_FONTS.get(ch) else { continue };
@@ -206,7 +203,7 @@ fn draw_text(img: &mut RgbImage, x: i32, y: i32, text: &str, color: Rgb<u8>) {
     }
 }
 
-fn fill_rect(img: &mut RgbImage, x: i32, y: i32, w: i32, h: i32, color: Rgb<u8>) {
+fn fill_rect(img: &mut Raster, x: i32, y: i32, w: i32, h: i32, color: [u8; 3]) {
     for yy in y..y + h {
         for xx in x..x + w {
             put(img, xx, yy, color);
@@ -214,7 +211,7 @@ fn fill_rect(img: &mut RgbImage, x: i32, y: i32, w: i32, h: i32, color: Rgb<u8>)
     }
 }
 
-fn put(img: &mut RgbImage, x: i32, y: i32, color: Rgb<u8>) {
+fn put(img: &mut Raster, x: i32, y: i32, color: [u8; 3]) {
     if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
         img.put_pixel(x as u32, y as u32, color);
     }
@@ -246,11 +243,11 @@ mod tests {
         assert_eq!(img.width(), MAP_PX + 1 + LEGEND_PX);
         let (cx, cy) = (600.0, 600.0);
         let car = img.get_pixel(cx as u32, (cy - 25.0 * px_per_m) as u32);
-        assert_eq!(car.0, flat_color(SemanticClass::CAR));
+        assert_eq!(car, flat_color(SemanticClass::CAR));
         let road = img.get_pixel((cx + 30.0 * px_per_m) as u32, (cy + 30.0 * px_per_m) as u32);
-        assert_eq!(road.0, flat_color(SemanticClass::ROAD));
+        assert_eq!(road, flat_color(SemanticClass::ROAD));
         // The ego arrow at the origin.
-        assert_eq!(img.get_pixel(cx as u32, cy as u32).0, WHITE.0);
+        assert_eq!(img.get_pixel(cx as u32, cy as u32), WHITE);
     }
 
     #[test]
@@ -266,6 +263,6 @@ mod tests {
         let img = draw(&m, &["t".into()], Some(2.5)).unwrap();
         let px_per_m = MAP_PX as f32 / 100.0;
         // Under the cut-away ceiling the road shows again.
-        assert_eq!(img.get_pixel((600.0 + 5.0 * px_per_m) as u32, 600).0, flat_color(SemanticClass::ROAD));
+        assert_eq!(img.get_pixel((600.0 + 5.0 * px_per_m) as u32, 600), flat_color(SemanticClass::ROAD));
     }
 }

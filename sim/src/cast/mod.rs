@@ -7,12 +7,14 @@ mod bvh;
 pub mod fixture;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+#[cfg(feature = "reference")]
 mod reference;
 pub mod watertight;
 mod wide4;
 
 pub use beams::{Beam, BeamSet, BeamSetError};
 pub use bvh::{BvhCaster, BvhLayout, BvhOptions};
+#[cfg(feature = "reference")]
 pub use reference::ParryCaster;
 
 use glam::Vec3;
@@ -31,6 +33,12 @@ pub fn gpu_adapter() -> Result<String, String> {
 /// Why a build without the cargo feature `gpu` has no GPU backend, and how to get one.
 pub const GPU_NOT_BUILT: &str =
     "not in this build (cargo feature `gpu`: `cargo install --path . --features full`, or `--features gpu`)";
+
+/// Whether this build has the reference caster ([`Backend::Parry`]; cargo feature `reference`).
+pub const REFERENCE_BUILT: bool = cfg!(feature = "reference");
+
+/// Why a build without the cargo feature `reference` has no reference caster, and how to get one.
+pub const REFERENCE_NOT_BUILT: &str = "not in this build (cargo feature `reference`: `cargo install --path . --features full`, or `--features reference`)";
 
 /// A ray: `origin + t * dir` for `t` in `[0, t_max]`; `dir` is unit length so `t` is metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,7 +88,14 @@ impl Backend {
     pub fn build(self, mesh: &SceneMesh) -> crate::error::Result<Box<dyn Caster>> {
         match self {
             Backend::Bvh => Ok(Box::new(BvhCaster::new(mesh))),
+            #[cfg(feature = "reference")]
             Backend::Parry => Ok(Box::new(ParryCaster::new(mesh))),
+            #[cfg(not(feature = "reference"))]
+            Backend::Parry => Err(crate::error::SimError::invalid(
+                "backend",
+                "parry",
+                format!("bvh: the reference backend is {REFERENCE_NOT_BUILT}"),
+            )),
             #[cfg(feature = "gpu")]
             Backend::Gpu => match gpu::GpuCaster::new(mesh) {
                 Ok(c) => Ok(Box::new(c)),

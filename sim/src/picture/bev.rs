@@ -1,7 +1,7 @@
 //! Bird's-eye view: the returns seen from above, vehicle origin at the centre, x (forward) up and
 //! y (left) to the left, with a metric scale bar.
 
-use image::{Rgb, RgbImage};
+use super::Raster;
 
 use super::color::{Coloring, paint};
 use super::draw::{ScaleBar, fill_rect, nice_floor, with_footer};
@@ -27,7 +27,7 @@ impl Default for BevOptions {
 }
 
 /// Draws the bird's-eye view of `cloud` with `coloring`, legend and scale bar.
-pub fn render_bev(cloud: &OrderedCloud, coloring: &Coloring, opts: &BevOptions) -> Result<RgbImage> {
+pub fn render_bev(cloud: &OrderedCloud, coloring: &Coloring, opts: &BevOptions) -> Result<Raster> {
     if !(16..=8192).contains(&opts.size_px) {
         return Err(SimError::invalid("size_px", opts.size_px, "16 ..= 8192"));
     }
@@ -56,7 +56,7 @@ pub fn render_bev(cloud: &OrderedCloud, coloring: &Coloring, opts: &BevOptions) 
     let size = opts.size_px;
     let m_per_px = 2.0 * half / size as f32;
     let c = size as f32 / 2.0;
-    let mut plot = RgbImage::from_pixel(size, size, Rgb([18, 18, 18]));
+    let mut plot = Raster::from_pixel(size, size, [18, 18, 18]);
     let off = (opts.point_px / 2) as i64;
     for (i, col) in colors.iter().enumerate() {
         let Some(col) = col else { continue };

@@ -1,8 +1,8 @@
 //! Raster primitives: filled rectangles, 8x8 bitmap text (`font8x8`), the footer with the legend
 //! and a scale bar.
 
+use super::Raster;
 use font8x8::legacy::BASIC_LEGACY;
-use image::{Rgb, RgbImage};
 
 use super::color::{Legend, viridis};
 
@@ -14,17 +14,17 @@ const TEXT: [u8; 3] = [235, 235, 235];
 const LINE_PX: u32 = 14;
 
 /// Fills the rectangle `[x, x + w) x [y, y + h)`, clipped to the image.
-pub(crate) fn fill_rect(img: &mut RgbImage, x: i64, y: i64, w: u32, h: u32, c: [u8; 3]) {
+pub(crate) fn fill_rect(img: &mut Raster, x: i64, y: i64, w: u32, h: u32, c: [u8; 3]) {
     let (iw, ih) = (i64::from(img.width()), i64::from(img.height()));
     for yy in y.max(0)..(y + i64::from(h)).min(ih) {
         for xx in x.max(0)..(x + i64::from(w)).min(iw) {
-            img.put_pixel(xx as u32, yy as u32, Rgb(c));
+            img.put_pixel(xx as u32, yy as u32, c);
         }
     }
 }
 
 /// Draws ASCII `text` with its top-left corner at `(x, y)`; returns the width drawn, pixels.
-pub(crate) fn text(img: &mut RgbImage, x: i64, y: i64, s: &str, c: [u8; 3]) -> u32 {
+pub(crate) fn text(img: &mut Raster, x: i64, y: i64, s: &str, c: [u8; 3]) -> u32 {
     for (k, ch) in s.chars().enumerate() {
         let glyph = BASIC_LEGACY[(ch as usize).min(127)];
         for (gy, bits) in glyph.iter().enumerate() {
@@ -63,7 +63,7 @@ pub(crate) fn nice_floor(x: f32) -> f32 {
 }
 
 /// Draws one legend item with its top-left corner at `(x, y)`.
-type DrawItem<'a> = Box<dyn Fn(&mut RgbImage, i64, i64) + 'a>;
+type DrawItem<'a> = Box<dyn Fn(&mut Raster, i64, i64) + 'a>;
 
 fn legend_items(legend: &Legend) -> Vec<(u32, DrawItem<'_>)> {
     match legend {
@@ -100,7 +100,7 @@ fn legend_items(legend: &Legend) -> Vec<(u32, DrawItem<'_>)> {
 
 /// Returns `plot` with a footer strip below it holding the legend (wrapped over lines as needed)
 /// and, if given, the scale bar at the right of the last line.
-pub(crate) fn with_footer(plot: &RgbImage, legend: &Legend, scale: Option<&ScaleBar>) -> RgbImage {
+pub(crate) fn with_footer(plot: &Raster, legend: &Legend, scale: Option<&ScaleBar>) -> Raster {
     let width = plot.width().max(160);
     let items = legend_items(legend);
     let scale_w = scale.map_or(0, |s| s.len_px.max(8 * s.label.len() as u32) + 16);
@@ -121,8 +121,8 @@ pub(crate) fn with_footer(plot: &RgbImage, legend: &Legend, scale: Option<&Scale
     let extra_line = scale.is_some() && last_used + scale_w > width;
     let n_lines = lines.len() as u32 + u32::from(extra_line) + u32::from(scale.is_some());
     let footer_h = n_lines * LINE_PX + 8;
-    let mut img = RgbImage::from_pixel(width, plot.height() + footer_h, Rgb(FOOTER_BG));
-    image::imageops::replace(&mut img, plot, 0, 0);
+    let mut img = Raster::from_pixel(width, plot.height() + footer_h, FOOTER_BG);
+    img.paste(plot, 0, 0);
     let top = i64::from(plot.height()) + 6;
     for (li, line) in lines.iter().enumerate() {
         let mut x = 8i64;
@@ -156,10 +156,10 @@ mod tests {
 
     #[test]
     fn text_draws_glyph_pixels() {
-        let mut img = RgbImage::new(16, 8);
+        let mut img = Raster::new(16, 8);
         let w = text(&mut img, 0, 0, "I", [255, 255, 255]);
         assert_eq!(w, 8);
-        let lit = img.pixels().filter(|p| p.0 == [255, 255, 255]).count();
+        let lit = img.pixels().filter(|p| *p == [255, 255, 255]).count();
         assert!(lit > 5 && lit < 40, "an `I` lights some pixels, got {lit}");
     }
 }

@@ -7,14 +7,14 @@ mod bev;
 mod color;
 mod draw;
 mod range;
+mod raster;
 
 pub use bev::{BevOptions, render_bev};
 pub use color::{Coloring, OUTCOME_COLORS};
 pub use range::{RangeOptions, render_range};
+pub use raster::Raster;
 
 use std::path::Path;
-
-use image::RgbImage;
 
 use crate::error::{Result, SimError};
 
@@ -42,10 +42,8 @@ impl View {
 }
 
 /// Encodes `img` as PNG and writes it to `path` atomically.
-pub fn save_png(path: &Path, img: &RgbImage) -> Result<()> {
-    let mut bytes = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| SimError::io(path, std::io::Error::other(e.to_string())))?;
+pub fn save_png(path: &Path, img: &Raster) -> Result<()> {
+    let bytes = img.to_png().map_err(|e| SimError::io(path, std::io::Error::other(e.to_string())))?;
     crate::io::atomic::write_bytes_atomic(path, &bytes)
 }
 
@@ -83,10 +81,10 @@ mod tests {
         assert_eq!(img.width(), 200);
         assert!(img.height() > 200, "footer below the plot");
         // Ground point (10, -0.5): u = 100 + 0.5 / 0.2 = 102.5, v = 100 - 10 / 0.2 = 50.
-        assert_eq!(img.get_pixel(102, 50).0, SemanticClass::ROAD.color());
+        assert_eq!(img.get_pixel(102, 50), SemanticClass::ROAD.color());
         // Car point (0, 5): u = 100 - 25 = 75, v = 100.
-        assert_eq!(img.get_pixel(75, 100).0, SemanticClass::CAR.color());
-        assert_eq!(img.get_pixel(10, 10).0, [18, 18, 18], "background");
+        assert_eq!(img.get_pixel(75, 100), SemanticClass::CAR.color());
+        assert_eq!(img.get_pixel(10, 10), [18, 18, 18], "background");
     }
 
     #[test]
@@ -95,9 +93,9 @@ mod tests {
         let img = render_range(&cloud(), &Coloring::Ground, &opts).unwrap();
         // 4 columns widen to 320 px (80 px each); 2 rows of 3 px.
         assert_eq!(img.width(), 320);
-        assert_eq!(img.get_pixel(0, 5).0, [200, 160, 90], "row 0 (ground) at the bottom");
-        assert_eq!(img.get_pixel(0, 0).0, [90, 160, 255], "row 1 (car) on top");
-        assert_eq!(img.get_pixel(319, 0).0, [0, 0, 0], "no return is black");
+        assert_eq!(img.get_pixel(0, 5), [200, 160, 90], "row 0 (ground) at the bottom");
+        assert_eq!(img.get_pixel(0, 0), [90, 160, 255], "row 1 (car) on top");
+        assert_eq!(img.get_pixel(319, 0), [0, 0, 0], "no return is black");
     }
 
     #[test]
@@ -108,10 +106,10 @@ mod tests {
         predicted[c.index(0, 1, 0)] = true; // false ground
         let opts = RangeOptions { row_px: Some(1), plane: 0 };
         let img = render_range(&c, &Coloring::Outcome { predicted_ground: &predicted }, &opts).unwrap();
-        assert_eq!(img.get_pixel(0, 1).0, OUTCOME_COLORS[0].0);
-        assert_eq!(img.get_pixel(0, 0).0, OUTCOME_COLORS[1].0);
-        assert_eq!(img.get_pixel(100, 1).0, OUTCOME_COLORS[2].0);
-        assert_eq!(img.get_pixel(100, 0).0, OUTCOME_COLORS[3].0);
+        assert_eq!(img.get_pixel(0, 1), OUTCOME_COLORS[0].0);
+        assert_eq!(img.get_pixel(0, 0), OUTCOME_COLORS[1].0);
+        assert_eq!(img.get_pixel(100, 1), OUTCOME_COLORS[2].0);
+        assert_eq!(img.get_pixel(100, 0), OUTCOME_COLORS[3].0);
         let short = Coloring::Outcome { predicted_ground: &predicted[..3] };
         assert!(render_range(&c, &short, &opts).is_err());
     }
@@ -122,8 +120,11 @@ mod tests {
         let path = dir.path().join("bev.png");
         let img = render_bev(&cloud(), &Coloring::Height, &BevOptions::default()).unwrap();
         save_png(&path, &img).unwrap();
-        let back = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(back, img);
+        let mut reader =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap())).read_info().unwrap();
+        let mut back = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut back).unwrap();
+        assert_eq!(back, img.as_raw());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
         assert!(View::parse("side").unwrap_err().to_string().contains("bev, range"));
     }

@@ -1,7 +1,7 @@
 //! Range image: the grid as a picture, one band of pixels per row (row 0, the lowest ring, at the
 //! bottom) and one pixel column per grid column, black where there is no return.
 
-use image::{Rgb, RgbImage};
+use super::Raster;
 
 use super::color::{Coloring, paint};
 use super::draw::{ScaleBar, fill_rect, nice_floor, with_footer};
@@ -19,7 +19,7 @@ pub struct RangeOptions {
 }
 
 /// Draws the range image of `cloud` with `coloring`, legend and a column scale bar.
-pub fn render_range(cloud: &OrderedCloud, coloring: &Coloring, opts: &RangeOptions) -> Result<RgbImage> {
+pub fn render_range(cloud: &OrderedCloud, coloring: &Coloring, opts: &RangeOptions) -> Result<Raster> {
     if cloud.planes > 0 && opts.plane >= cloud.planes {
         return Err(SimError::invalid("plane", opts.plane, format!("0 ..= {}", cloud.planes - 1)));
     }
@@ -36,7 +36,7 @@ pub fn render_range(cloud: &OrderedCloud, coloring: &Coloring, opts: &RangeOptio
         None => (width / (4 * rows)).clamp(1, 16),
     };
     let height = rows * row_px;
-    let mut plot = RgbImage::from_pixel(width, height, Rgb([0, 0, 0]));
+    let mut plot = Raster::new(width, height);
     for row in 0..cloud.rows {
         let y = i64::from(height) - i64::from(row_px) * (row as i64 + 1);
         for col in 0..cloud.cols {

@@ -46,6 +46,10 @@ struct TopicCount {
 /// libmcap's `CompressionLevel::Fastest` for zstd, the level of rosbag2's `zstd_fast` preset.
 pub const ZSTD_FASTEST: i32 = -5;
 
+/// Why a build without the cargo feature `bag-compression` reads and writes only uncompressed bag
+/// chunks, and how to get zstd and LZ4 (the C libraries are ~60 s of CPU in a first build).
+pub const COMPRESSION_NOT_BUILT: &str = "not in this build (cargo feature `bag-compression`: `cargo install --path . --features full`, or `--features bag-compression`)";
+
 /// How a bag's chunks are compressed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BagCompression {
@@ -169,24 +173,31 @@ impl BagWriter {
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir_all(&staging).map_err(|e| bag_error(&staging, e))?;
         let file_name = format!("{name}_0.mcap");
+        #[cfg(not(feature = "bag-compression"))]
+        if compression == BagCompression::Zstd {
+            return Err(SimError::invalid("bag compression", "zstd", format!("none: zstd is {COMPRESSION_NOT_BUILT}")));
+        }
         let file = std::fs::File::create(staging.join(&file_name)).map_err(|e| bag_error(&staging, e))?;
         let options = mcap::WriteOptions::new()
             .profile("ros2")
             .library("groundtruth")
             .compression(match compression {
+                #[cfg(feature = "bag-compression")]
                 BagCompression::Zstd => Some(mcap::Compression::Zstd),
+                #[cfg(not(feature = "bag-compression"))]
+                BagCompression::Zstd => None,
                 BagCompression::None => None,
             })
-            // rosbag2's `zstd_fast` preset (`ros2 bag record -s mcap --storage-preset-profile
-            // zstd_fast`): zstd at libmcap's `Fastest` level, zstd level -5 (the mcap crate
-            // takes the level as a u32 and casts it back to i32, so -5 travels as its two's
-            // complement). Measured on 100 city frames (docs/ros2.md): half the compression
-            // work of level 1 for files 1.42x larger, still smaller than the KITTI files of the
-            // same scan. Chunks of 768 KiB (libmcap's default). One compression thread: the bytes
-            // do not depend on the machine.
-            .compression_level(ZSTD_FASTEST as u32)
-            .chunk_size(Some(768 * 1024))
-            .compression_threads(0);
+            .chunk_size(Some(768 * 1024));
+        // rosbag2's `zstd_fast` preset (`ros2 bag record -s mcap --storage-preset-profile
+        // zstd_fast`): zstd at libmcap's `Fastest` level, zstd level -5 (the mcap crate
+        // takes the level as a u32 and casts it back to i32, so -5 travels as its two's
+        // complement). Measured on 100 city frames (docs/ros2.md): half the compression
+        // work of level 1 for files 1.42x larger, still smaller than the KITTI files of the
+        // same scan. Chunks of 768 KiB (libmcap's default). One compression thread: the bytes
+        // do not depend on the machine.
+        #[cfg(feature = "bag-compression")]
+        let options = options.compression_level(ZSTD_FASTEST as u32).compression_threads(0);
         let writer = options.create(BufWriter::with_capacity(1 << 20, file)).map_err(|e| bag_error(dir, e))?;
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -738,6 +749,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(feature = "bag-compression"), ignore = "zstd bags need the `bag-compression` feature")]
     fn a_bag_round_trips_and_lists_its_topics() {
         let dir = tempfile::tempdir().unwrap();
         let bag = dir.path().join("scan");
@@ -793,6 +805,7 @@ mod tests {
     /// A bag from another writer: lz4 chunks (Foxglove's tools and some converters write them),
     /// no summary section, no `metadata.yaml`, two messages per chunk; and a sqlite3 rosbag2
     /// directory, refused by name.
+    #[cfg(feature = "bag-compression")]
     #[test]
     fn lz4_chunks_without_a_summary_and_sqlite3_bags() {
         let dir = tempfile::tempdir().unwrap();

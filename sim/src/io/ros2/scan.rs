@@ -144,6 +144,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(feature = "bag-compression"), ignore = "zstd bags need the `bag-compression` feature")]
     fn a_scan_becomes_a_bag_with_one_cloud_per_frame_and_sensor() {
         let (rig, frames) = two_lux_frames();
         let dir = tempfile::tempdir().unwrap();
@@ -174,6 +175,7 @@ mod tests {
     /// The default compression (zstd level -5) and none give the same messages: the same CDR
     /// bytes at the same times, what an uncompressed scan writes; the zstd file is the smaller.
     #[test]
+    #[cfg_attr(not(feature = "bag-compression"), ignore = "zstd bags need the `bag-compression` feature")]
     fn compressed_and_uncompressed_bags_hold_the_same_messages() {
         let (rig, frames) = two_lux_frames();
         let dir = tempfile::tempdir().unwrap();

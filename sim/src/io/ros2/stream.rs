@@ -50,7 +50,14 @@ impl StreamError {
 
 impl From<mcap::McapError> for StreamError {
     fn from(e: mcap::McapError) -> Self {
-        Self { truncated: matches!(e, mcap::McapError::UnexpectedEof), message: e.to_string() }
+        let message = match &e {
+            // A build without zstd and LZ4 names what it lacks and how to get it.
+            mcap::McapError::UnsupportedCompression(name) if !cfg!(feature = "bag-compression") => {
+                format!("chunks compressed with `{name}`: decompression is {}", super::bag::COMPRESSION_NOT_BUILT)
+            }
+            _ => e.to_string(),
+        };
+        Self { truncated: matches!(e, mcap::McapError::UnexpectedEof), message }
     }
 }
 
