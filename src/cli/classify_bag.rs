@@ -32,6 +32,8 @@ pub fn run(
     method: &mut dyn classifier::GroundClassifier,
 ) -> anyhow::Result<()> {
     let topic = recording.topic().unwrap_or_default();
+    // The ground bag is zstd-compressed: a build without the compression says so before reading.
+    sim::io::ros2::BagCompression::default().check_built()?;
     // The topic is checked (and its messages start coming) before anything is written.
     let mut frames = recording.frames(Ordering::Ordered(setup))?;
     std::fs::create_dir_all(out).with_context(|| format!("creating `{}`", out.display()))?;

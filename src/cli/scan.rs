@@ -196,20 +196,24 @@ pub fn scan_to_dir(args: &Args) -> anyhow::Result<Manifest> {
     let (frame_count, weather) = (config.frames, config.weather);
     let (speed_m_per_s, yaw_rate_rad_per_s) = (config.speed_m_per_s, config.yaw_rate_rad_per_s);
     let scanner = Scanner::new(&scene.mesh, &rig, config)?;
+    // Checked before anything is created: a compression this build lacks leaves nothing behind.
+    let compression = match formats.mcap {
+        true => Some(sim::io::ros2::BagCompression::parse(&args.bag_compression)?.check_built()?),
+        false => None,
+    };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating output directory {}", args.out.display()))?;
 
     let single = rig.sensors.len() == 1;
     let sensor_from_vehicle = single.then(|| rig.sensors[0].mount.vehicle_from_sensor().inverse());
     // The bag: every frame's clouds, its pose and the mounts (sim::io::ros2::scan).
     let sensor_topics = sim::io::ros2::scan::sensor_topics(&rig);
-    let mut bag = match formats.mcap {
-        true => {
-            let compression = sim::io::ros2::BagCompression::parse(&args.bag_compression)?;
+    let mut bag = match compression {
+        Some(compression) => {
             let mut b = sim::io::ros2::BagWriter::create_with(&args.out.join(BAG_DIR), compression)?;
             sim::io::ros2::scan::write_static(&mut b, &sensor_topics)?;
             Some(b)
         }
-        false => None,
+        None => None,
     };
     // A pipeline: this thread casts frame k + 1 (on the rayon pool) while a writer thread encodes
     // and writes frame k; the files and their order do not depend on the timing.

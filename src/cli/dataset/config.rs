@@ -157,6 +157,13 @@ impl DatasetConfig {
                 if !["pcd", "ply", "las", "mcap"].contains(&f.as_str()) {
                     bail!("`{at}.formats`: unknown format `{f}`; allowed: pcd, ply, las, mcap");
                 }
+                if f == "mcap" {
+                    // The bags are zstd-compressed: refused here, before anything is written, in
+                    // a build without the compression.
+                    sim::io::ros2::BagCompression::default()
+                        .check_built()
+                        .with_context(|| format!("`{at}.formats`"))?;
+                }
             }
         }
         if total > MAX_FRAMES_TOTAL && !allow_large {

@@ -74,6 +74,18 @@ impl BagCompression {
             other => Err(SimError::invalid("bag compression", other, "zstd or none")),
         }
     }
+
+    /// `self`, or an error naming the cargo feature where this build cannot write it (zstd
+    /// without `bag-compression`).
+    pub fn check_built(self) -> Result<Self> {
+        match self {
+            #[cfg(not(feature = "bag-compression"))]
+            Self::Zstd => {
+                Err(SimError::invalid("bag compression", "zstd", format!("none: zstd is {COMPRESSION_NOT_BUILT}")))
+            }
+            other => Ok(other),
+        }
+    }
 }
 
 /// What the writer thread is asked to do; ids are the caller's (0, 1, ... in order of
@@ -165,6 +177,7 @@ impl BagWriter {
 
     /// [`BagWriter::create`] with a choice of chunk compression.
     pub fn create_with(dir: &Path, compression: BagCompression) -> Result<Self> {
+        let compression = compression.check_built()?;
         let name = dir.file_name().and_then(|n| n.to_str()).filter(|n| !n.is_empty()).unwrap_or("bag").to_string();
         let parent = dir.parent().map(Path::to_path_buf).unwrap_or_default();
         std::fs::create_dir_all(if parent.as_os_str().is_empty() { Path::new(".") } else { &parent })
@@ -173,10 +186,6 @@ impl BagWriter {
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir_all(&staging).map_err(|e| bag_error(&staging, e))?;
         let file_name = format!("{name}_0.mcap");
-        #[cfg(not(feature = "bag-compression"))]
-        if compression == BagCompression::Zstd {
-            return Err(SimError::invalid("bag compression", "zstd", format!("none: zstd is {COMPRESSION_NOT_BUILT}")));
-        }
         let file = std::fs::File::create(staging.join(&file_name)).map_err(|e| bag_error(&staging, e))?;
         let options = mcap::WriteOptions::new()
             .profile("ros2")
