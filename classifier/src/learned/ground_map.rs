@@ -56,6 +56,8 @@ pub struct GroundMap {
     /// Per point given to [`GroundMap::build`]: its fine cell ([`cell_of`]; `u32::MAX` where the
     /// point is not finite).
     point_cell: Vec<u32>,
+    /// The heights of the ground returns within 20 m (reused between frames).
+    near: Vec<f32>,
     /// The frame's ground level: the median height of the ground returns within 20 m.
     pub global_level: f32,
 }
@@ -78,7 +80,8 @@ impl GroundMap {
         self.span.resize(SIDE * SIDE, (f32::INFINITY, f32::NEG_INFINITY, 0));
         self.coarse.clear();
         self.coarse.resize(COARSE_SIDE * COARSE_SIDE, (0.0, 0));
-        let mut near = Vec::new();
+        let mut near = std::mem::take(&mut self.near);
+        near.clear();
         self.point_cell.clear();
         self.point_cell.resize(points.len(), u32::MAX);
         for ((p, &g), point_cell) in points.iter().zip(ground).zip(&mut self.point_cell) {
@@ -116,6 +119,7 @@ impl GroundMap {
             let k = near.len() / 2;
             *near.select_nth_unstable_by(k, f32::total_cmp).1
         };
+        self.near = near;
         // Coarse levels: the cell's mean, else the mean over its 3 x 3 coarse neighbours, else the
         // frame's level.
         self.coarse_level.clear();
