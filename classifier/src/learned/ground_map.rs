@@ -137,9 +137,9 @@ impl GroundMap {
         }
         // Fine levels: the cell's mean, else the mean over the 5 x 5 cells around it, else the
         // coarse level.
-        self.level.clear();
+        // Every cell's level and every summary read below is written in this pass: no clearing
+        // (1 MB of stores a frame).
         self.level.resize(SIDE * SIDE, 0.0);
-        self.summary.clear();
         self.summary.resize(SIDE * SIDE, CellSummary::default());
         for i in 0..SIDE {
             for j in 0..SIDE {
@@ -168,7 +168,8 @@ impl GroundMap {
         }
     }
 
-    /// What the features read of fine cell `c` (a cell holding a return; the default elsewhere).
+    /// What the features read of fine cell `c`, a cell holding a return of the last
+    /// [`GroundMap::build`] (elsewhere: what an earlier frame left, or the default).
     #[inline]
     pub fn summary(&self, c: usize) -> &CellSummary {
         &self.summary[c]
