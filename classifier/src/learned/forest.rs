@@ -246,13 +246,17 @@ mod tests {
 
     #[test]
     fn lanes_give_the_models_own_margins() {
-        // Trees up to depth 6 (the AVX-512 tables) and up to 9 (the other loop).
+        // Trees up to depth 6 (the AVX-512 and AVX2 tables) and up to 9 (the other loop); cell
+        // counts below one chunk, with a 16-cell tail after 32-cell chunks, and a whole number of
+        // chunks.
         for max_depth in [6, 9] {
-            margins_agree(max_depth);
+            for count in [5, 37, 64] {
+                margins_agree(max_depth, count);
+            }
         }
     }
 
-    fn margins_agree(max_depth: usize) {
+    fn margins_agree(max_depth: usize, count: usize) {
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(3);
         let trees: Vec<ObliviousTree> = (0..40)
             .map(|k| {
@@ -266,7 +270,6 @@ mod tests {
             .collect();
         let model = LearnedModel::new(0.25, 0.5, trees);
         let forest = Forest::new(&model);
-        let count: usize = 37;
         let padded = count.div_ceil(LANES) * LANES;
         let columns: Vec<Vec<f32>> =
             (0..FEATURE_COUNT).map(|_| (0..padded).map(|_| rng.random::<f32>()).collect()).collect();
@@ -275,8 +278,8 @@ mod tests {
         forest.margins_any(&columns, count, &mut portable);
         for j in 0..count {
             let x: [f32; FEATURE_COUNT] = std::array::from_fn(|k| columns[k][j]);
-            assert_eq!(out[j], model.margin(&x), "cell {j}, depth up to {max_depth}");
-            assert_eq!(portable[j], out[j], "cell {j}, depth up to {max_depth}");
+            assert_eq!(out[j], model.margin(&x), "cell {j} of {count}, depth up to {max_depth}");
+            assert_eq!(portable[j], out[j], "cell {j} of {count}, depth up to {max_depth}");
         }
     }
 }
