@@ -20,7 +20,7 @@
 //! | `gradient_below`, `gradient_above` | the steepness of the step to the next return below and above it in its column (within 3 rows; [`NO_NEIGHBOUR`] where none): `rise * abs(rise) / run^2`, the squared tangent with its sign. The trees split on order, so any monotone measure of the slope does, and this one needs no arctangent or square root |
 //! | `row_step_m` | mean height step to its left and right neighbours in its row (within 1 m; [`NO_NEIGHBOUR`] where none) |
 
-use super::ground_map::{GroundMap, cell_of};
+use super::ground_map::GroundMap;
 use crate::nitsch::Nitsch;
 
 /// Number of features.
@@ -245,30 +245,64 @@ impl FeatureColumns {
             unreachable!("FEATURE_COUNT columns")
         };
         let has_features = f.g_rho.len() == n && f.n_rho.len() == n && f.normal.len() == n;
-        for (j, &cell) in self.cells.iter().enumerate() {
-            let i = cell as usize;
-            let p = points[i];
-            (normal_z[j], n_rho[j], g_rho[j]) =
-                if has_features { (f.normal[i].z, f.n_rho[i], f.g_rho[i]) } else { (0.0, 0.0, 0.0) };
-            decided[j] = f32::from(u8::from(nitsch_ground[i]));
-            let rm = cloud.range_m[i];
-            range[j] = if rm.is_finite() { rm } else { p.length() };
-            let m = cell_of(p);
-            above_ground[j] = p.z - map.level(m);
-            above_coarse[j] = p.z - map.coarse_level(m);
-            above_frame[j] = p.z - map.global_level;
-            let (lo, hi, returns) = map.span(m);
-            above_lowest[j] = p.z - lo;
-            span[j] = hi - lo;
-            share[j] = map.ground_count(m) as f32 / returns.max(1) as f32;
-            gradient_below[j] = g.below[i];
-            gradient_above[j] = g.above[i];
-            row_step[j] = g.row_step[i];
+        let (cells, points, ground) = (&self.cells[..count], &points[..n], &nitsch_ground[..n]);
+        // Four passes over the returns, each writing a few columns as slices of exactly `count`
+        // values (no bounds check per store, the column pointers in registers).
+        {
+            let (normal_z, n_rho, g_rho, decided) =
+                (&mut normal_z[..count], &mut n_rho[..count], &mut g_rho[..count], &mut decided[..count]);
+            if has_features {
+                let (normal, nr, gr) = (&f.normal[..n], &f.n_rho[..n], &f.g_rho[..n]);
+                for (j, &cell) in cells.iter().enumerate() {
+                    let i = cell as usize;
+                    (normal_z[j], n_rho[j], g_rho[j]) = (normal[i].z, nr[i], gr[i]);
+                }
+            } else {
+                normal_z.fill(0.0);
+                n_rho.fill(0.0);
+                g_rho.fill(0.0);
+            }
+            for (j, &cell) in cells.iter().enumerate() {
+                decided[j] = f32::from(u8::from(ground[cell as usize]));
+            }
+        }
+        {
+            let (range, above_ground, above_coarse, above_frame) = (
+                &mut range[..count],
+                &mut above_ground[..count],
+                &mut above_coarse[..count],
+                &mut above_frame[..count],
+            );
+            let (above_lowest, span, share) = (&mut above_lowest[..count], &mut span[..count], &mut share[..count]);
+            let (point_cells, range_m) = (&map.point_cells()[..n], &cloud.range_m[..n]);
+            let global_level = map.global_level;
+            for (j, &cell) in cells.iter().enumerate() {
+                let i = cell as usize;
+                let p = points[i];
+                let rm = range_m[i];
+                range[j] = if rm.is_finite() { rm } else { p.length() };
+                let m = map.summary(point_cells[i] as usize);
+                above_ground[j] = p.z - m.level;
+                above_coarse[j] = p.z - m.coarse_level;
+                above_frame[j] = p.z - global_level;
+                above_lowest[j] = p.z - m.lowest;
+                span[j] = m.span;
+                share[j] = m.ground_share;
+            }
+        }
+        {
+            let (gradient_below, gradient_above, row_step) =
+                (&mut gradient_below[..count], &mut gradient_above[..count], &mut row_step[..count]);
+            let (below, above, row_steps) = (&g.below[..n], &g.above[..n], &g.row_step[..n]);
+            for (j, &cell) in cells.iter().enumerate() {
+                let i = cell as usize;
+                (gradient_below[j], gradient_above[j], row_step[j]) = (below[i], above[i], row_steps[i]);
+            }
         }
         // Cluster sizes: a walk up the union-find forest per candidate (scalar; most cells are not
         // candidates).
-        for (j, &cell) in self.cells.iter().enumerate() {
-            cluster_size[j] = ws.cluster_of(cell as usize).map_or(0.0, |root| ws.cluster_size(root) as f32);
+        for (size, &cell) in cluster_size[..count].iter_mut().zip(cells) {
+            *size = ws.cluster_of(cell as usize).map_or(0.0, |root| ws.cluster_size(root) as f32);
         }
     }
 

@@ -22,6 +22,22 @@ pub const SIDE: usize = (2.0 * HALF_EXTENT_M / CELL_M) as usize;
 
 const COARSE_SIDE: usize = SIDE / COARSE;
 
+/// What the learned features read of a fine cell, together (one cache line for a return, not
+/// four arrays).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CellSummary {
+    /// The ground height used (filled), as [`GroundMap::level`].
+    pub level: f32,
+    /// The coarse cell's ground height, as [`GroundMap::coarse_level`].
+    pub coarse_level: f32,
+    /// The lowest return.
+    pub lowest: f32,
+    /// Highest minus lowest return.
+    pub span: f32,
+    /// Ground returns over returns (0 where the cell holds none).
+    pub ground_share: f32,
+}
+
 /// The map of one frame; buffers are reused between frames.
 #[derive(Clone, Debug, Default)]
 pub struct GroundMap {
@@ -35,6 +51,13 @@ pub struct GroundMap {
     level: Vec<f32>,
     /// Per coarse cell: the ground height used (filled).
     coarse_level: Vec<f32>,
+    /// Per fine cell: what the features read.
+    summary: Vec<CellSummary>,
+    /// Per point given to [`GroundMap::build`]: its fine cell ([`cell_of`]; `u32::MAX` where the
+    /// point is not finite).
+    point_cell: Vec<u32>,
+    /// The heights of the ground returns within 20 m (reused between frames).
+    near: Vec<f32>,
     /// The frame's ground level: the median height of the ground returns within 20 m.
     pub global_level: f32,
 }
@@ -57,12 +80,16 @@ impl GroundMap {
         self.span.resize(SIDE * SIDE, (f32::INFINITY, f32::NEG_INFINITY, 0));
         self.coarse.clear();
         self.coarse.resize(COARSE_SIDE * COARSE_SIDE, (0.0, 0));
-        let mut near = Vec::new();
-        for (p, &g) in points.iter().zip(ground) {
+        let mut near = std::mem::take(&mut self.near);
+        near.clear();
+        self.point_cell.clear();
+        self.point_cell.resize(points.len(), u32::MAX);
+        for ((p, &g), point_cell) in points.iter().zip(ground).zip(&mut self.point_cell) {
             if !p.is_finite() {
                 continue;
             }
             let c = cell_of(*p);
+            *point_cell = c as u32;
             let s = &mut self.span[c];
             s.0 = s.0.min(p.z);
             s.1 = s.1.max(p.z);
@@ -92,6 +119,7 @@ impl GroundMap {
             let k = near.len() / 2;
             *near.select_nth_unstable_by(k, f32::total_cmp).1
         };
+        self.near = near;
         // Coarse levels: the cell's mean, else the mean over its 3 x 3 coarse neighbours, else the
         // frame's level.
         self.coarse_level.clear();
@@ -109,8 +137,10 @@ impl GroundMap {
         }
         // Fine levels: the cell's mean, else the mean over the 5 x 5 cells around it, else the
         // coarse level.
-        self.level.clear();
+        // Every cell's level and every summary read below is written in this pass: no clearing
+        // (1 MB of stores a frame).
         self.level.resize(SIDE * SIDE, 0.0);
+        self.summary.resize(SIDE * SIDE, CellSummary::default());
         for i in 0..SIDE {
             for j in 0..SIDE {
                 let c = i * SIDE + j;
@@ -124,8 +154,32 @@ impl GroundMap {
                     let (s, n) = neighbourhood(&self.ground, SIDE, i, j, 2);
                     if n > 0 { s / n as f32 } else { self.coarse_level[(i / COARSE) * COARSE_SIDE + j / COARSE] }
                 };
+                let (lowest, highest, returns) = self.span[c];
+                if returns > 0 {
+                    self.summary[c] = CellSummary {
+                        level: self.level[c],
+                        coarse_level: self.coarse_level(c),
+                        lowest,
+                        span: highest - lowest,
+                        ground_share: self.ground[c].1 as f32 / returns as f32,
+                    };
+                }
             }
         }
+    }
+
+    /// What the features read of fine cell `c`, a cell holding a return of the last
+    /// [`GroundMap::build`] (elsewhere: what an earlier frame left, or the default).
+    #[inline]
+    pub fn summary(&self, c: usize) -> &CellSummary {
+        &self.summary[c]
+    }
+
+    /// The fine cell of every point given to the last [`GroundMap::build`], `u32::MAX` for
+    /// points that are not finite.
+    #[inline]
+    pub fn point_cells(&self) -> &[u32] {
+        &self.point_cell
     }
 
     /// The ground height under fine cell `c`.
