@@ -299,7 +299,7 @@ pub fn noise() -> impl Strategy<Value = bool> {
 }
 
 /// Weather drawn from the given ranges: fog of visibility `visibility_m`, rain and snow of rate
-/// `rain_mm_h` / `snow_mm_h` (within 1 ..= 100000 m, 0 ..= 200 mm/h and 0 ..= 5 mm/h), each kind
+/// `rain_mm_h` / `snow_mm_h` (within 1 ..= 100000 m, 0 ..= 50 mm/h and 0 ..= 5 mm/h), each kind
 /// equally likely; use as `scenario.weather(w)`.
 ///
 /// ```
