@@ -37,8 +37,12 @@ git ls-files -z | grep -zv '^Cargo.lock$' | xargs -0 tar -cf - | tar -xf - -C "$
     cargo tree --workspace -e normal -i glam --depth 0 --prefix none --format '{p}'
 )
 
-echo "== cargo install --path . (no --locked)"
-cargo install --path . --root "$work/install"
+# INSTALL_PROFILE=dev (CI) installs the unoptimised build (`--debug`), reusing the test build's
+# dependencies where the fresh resolution agrees; the default is the release build users get.
+install_args=()
+[ "${INSTALL_PROFILE:-release}" = dev ] && install_args=(--debug)
+echo "== cargo install --path . (no --locked) ${install_args[*]}"
+cargo install --path . --root "$work/install" "${install_args[@]}"
 "$work/install/bin/groundtruth" --version
 "$work/install/bin/groundtruth" list >/dev/null
 echo "installed and ran: $("$work/install/bin/groundtruth" --version)"

@@ -41,8 +41,12 @@ if [ -z "${GROUNDTRUTH_BIN:-}" ]; then
   GROUNDTRUTH_BIN="$CARGO_TARGET_DIR/release/groundtruth"
 fi
 
-log "pip install ./python (maturin, release)"
-"$py" -m pip install -q --no-build-isolation --force-reinstall --no-deps ./python
+# GT_PY_PROFILE: the cargo profile of the extension (default release, as the README's `pip install`
+# builds it). CI passes `dev`: the test build's dependencies are reused instead of optimised again.
+profile="${GT_PY_PROFILE:-release}"
+log "pip install ./python (maturin, $profile profile)"
+MATURIN_PEP517_ARGS="--profile $profile" \
+  "$py" -m pip install -q --no-build-isolation --force-reinstall --no-deps ./python
 
 log "mypy.stubtest: the type stubs match the module"
 (cd "$CARGO_TARGET_DIR" && "$py" -m mypy.stubtest groundtruth._native)
