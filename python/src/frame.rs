@@ -305,8 +305,8 @@ impl Frame {
     /// `classify` prints), as a dict: `summary` (the line `groundtruth classify` prints: `ordered
     /// into ROWS x COLS x PLANES: path ...; sensor matched: vlp16 (...)` or `... unnamed sensor: ...`),
     /// `sensor` (`model`: the catalogue's sensor matched, None for an unnamed one; `rings`, `rows`,
-    /// `columns`, `order`, `echoes`, `mean_error_deg`; None where a rig, a calibration file or a
-    /// ring field gave the sensor), `path` (`"unfolded"`, `"beam-table"`, `"ring-field"`,
+    /// `columns`, `order`, `echoes`, `mean_error_deg`; None where `rig` or `calibration` named
+    /// the sensor, or none was recovered), `path` (`"unfolded"`, `"beam-table"`, `"ring-field"`,
     /// `"organized"`; None for one of our own files kept as written), the counts (`points`,
     /// `placed`, `moved`, `stacked`, `shared`, `outside`, `skipped`, `no_returns`, `rings_found`),
     /// `fallback`, `rows`, `cols`, `planes`, and where the frame came from (`file`, `layout`,

@@ -171,4 +171,7 @@ def test_classify_an_unorganized_file_is_refused_not_crashed(tmp_path):
     assert back.shape == (1, f.returns)
     with pytest.raises(ValueError, match="too small"):
         gt.classify(back)
-    assert gt.read(tmp_path / "f.bin").shape == f.shape
+    # Ordered: `flat` lights the lower 8 of the 16 beams, an unnamed 8-ring sensor, as the CLI says.
+    ordered = gt.read(tmp_path / "f.bin")
+    assert ordered.shape == (8, f.cols) and ordered.ordering["sensor"]["model"] is None
+    assert gt.classify(ordered).shape == ordered.shape

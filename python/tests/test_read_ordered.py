@@ -137,6 +137,11 @@ def test_bad_arguments_name_themselves(bins, tmp_path):
     for name, value in (("rig", "vlp16-roof"), ("calibration", bad)):
         with pytest.raises(ValueError, match=f"^{name}: .*ordered=False"):
             gt.read(path, ordered=False, **{name: value})
+    back = gt.read(path)
+    with pytest.raises(ValueError, match="^decisions: "):
+        back.decisions_per_point(np.zeros((3, 3), dtype=bool))
+    with pytest.raises(TypeError, match="^decisions: "):
+        back.decisions_per_point(np.zeros(back.shape, dtype=np.uint8))
     # Points in no order a sensor gives: refused, naming the path and the way out.
     rng = np.random.default_rng(0)
     noise = tmp_path / "noise.bin"
