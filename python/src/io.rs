@@ -61,7 +61,6 @@ fn extension(path: &Path) -> String {
 /// outright.
 #[pyfunction]
 #[pyo3(signature = (path, topic=None, layout=None, rig=None, calibration=None, ordered=true))]
-#[allow(clippy::too_many_arguments)] // Python keyword arguments, as the command line's flags.
 pub fn read<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -103,7 +102,6 @@ pub fn read<'py>(
 
 /// The sensor setup of `rig` and `calibration`, as `groundtruth classify --rig --calibration`
 /// builds it ([`recording::sensor_setup`]); an error names the argument at fault.
-#[allow(clippy::result_large_err)] // One error per call.
 fn sensor_setup(rig: Option<&str>, calibration: Option<&Path>) -> PyResult<SensorSetup> {
     let with_rig = recording::sensor_setup(rig, None).map_err(|e| value_error("rig", e))?;
     let Some(file) = calibration else { return Ok(with_rig) };
