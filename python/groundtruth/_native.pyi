@@ -131,6 +131,19 @@ class Frame:
     def points(self) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.int64]]:
         """The returns as ``(N, 4)`` ``x y z intensity`` (vehicle frame) in grid order, and their flat
         cell indices: ``frame.xyz.reshape(-1, 3)[cells] == points[:, :3]``."""
+    @property
+    def ordering(self) -> Optional[dict[str, Any]]:
+        """How ``read()`` ordered the frame (``summary``: the line ``groundtruth classify`` prints;
+        ``sensor``: the catalogue's sensor matched (``model``) or None where one was given; ``path``,
+        the counts, ``rows``, ``cols``, ``planes``, ``file``, ``layout``, ``layout_by``, ...); None
+        for scans and frames read with ``ordered=False``."""
+    @property
+    def cell_of_point(self) -> Optional[npt.NDArray[np.int64]]:
+        """The flat cell of each point of the file read, in the file's order (-1: skipped); None
+        where the frame was not reordered."""
+    def decisions_per_point(self, decisions: npt.NDArray[np.bool_]) -> npt.NDArray[np.uint8]:
+        """``(H, W)`` decisions as one uint8 per point of the file read, in its own order (1 =
+        ground): the bytes of ``groundtruth classify``'s ``.ground`` file."""
     def region(self, name: str) -> npt.NDArray[np.bool_]:
         """The ``(H, W)`` mask of region ``name``; ``ValueError`` for a region of another family."""
     def regions(self) -> dict[str, npt.NDArray[np.bool_]]:
@@ -244,11 +257,24 @@ def eval_dataset(
     ``result["methods"]["learned"]["pooled"]["f1"]``, per frame under ``"frames"``. ``layout``
     (``"kitti"``, ``"nuscenes"``) names the records of the ``.bin`` files."""
 
-def read(path: _Path, topic: Optional[str] = None, layout: Optional[str] = None) -> Union[Frame, list[Frame]]:
+def read(
+    path: _Path,
+    topic: Optional[str] = None,
+    layout: Optional[str] = None,
+    rig: Optional[str] = None,
+    calibration: Optional[_Path] = None,
+    ordered: bool = True,
+) -> Union[Frame, list[Frame]]:
     """Read a ``.pcd``, ``.ply``, ``.las``, KITTI ``.bin`` (+ ``.label``) or nuScenes ``.pcd.bin`` into
-    a Frame; unorganized files give a ``(1, N)`` grid in file order. ``layout`` (``"kitti"``,
-    ``"nuscenes"``) names the records of a ``.bin`` (default: by name and content). A ROS 2 bag (``.mcap`` or a rosbag2 directory) gives
-    a list of Frames, one per PointCloud2 message of ``topic``."""
+    a Frame, ordered into rings and columns as ``groundtruth classify`` orders it (``ordered=True``):
+    a ring-less ``.bin`` or an unorganized cloud gets its rings and columns recovered (the sensor
+    matched against the catalogue, or an unnamed sensor), from its ring field, or from ``rig`` (a
+    single-sensor rig, as ``--rig``) or ``calibration`` (the sensor's calibration file, as
+    ``--calibration``); ``Frame.ordering`` says how. ``ValueError`` (naming the argument) where no
+    order can be recovered. ``ordered=False`` reads it as stored (unorganized files give a
+    ``(1, N)`` grid in file order). ``layout`` (``"kitti"``, ``"nuscenes"``) names the records of a
+    ``.bin`` (default: by name and content). A ROS 2 bag (``.mcap`` or a rosbag2 directory) gives a
+    list of Frames, one per PointCloud2 message of ``topic``."""
 
 def write(
     frame: Union[Frame, Sequence[Frame]], path: _Path, format: Optional[str] = None, layout: str = "groundtruth"

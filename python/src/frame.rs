@@ -16,7 +16,8 @@ use sim::OrderedCloud;
 
 use crate::args::type_name;
 use crate::error::{scenario_error, type_error};
-use crate::score::parse_region;
+use crate::ordering::ReadOrdering;
+use crate::score::{cell_decisions, parse_region};
 
 /// One frame of a scan, or a file read back: the labelled ordered cloud as numpy arrays.
 ///
@@ -29,6 +30,9 @@ pub struct Frame {
     pub scan: Arc<Scan>,
     /// Index of the frame in `scan`.
     pub k: usize,
+    /// How the frame was ordered, for a frame read with `read(..., ordered=True)`; `None` for
+    /// scans and frames read as stored.
+    pub ordering: Option<Arc<ReadOrdering>>,
 }
 
 impl Frame {
@@ -295,6 +299,47 @@ impl Frame {
     /// Every region this frame's scene has, name -> bool `(H, W)` mask (as `groundtruth.regions`).
     fn regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         crate::score::regions_of(py, self)
+    }
+
+    /// How `read()` put the frame into rings and columns (the ordering report the command line's
+    /// `classify` prints), as a dict: `summary` (the line `groundtruth classify` prints: `ordered
+    /// into ROWS x COLS x PLANES: path ...; sensor matched: vlp16 (...)` or `... unnamed sensor: ...`),
+    /// `sensor` (`model`: the catalogue's sensor matched, None for an unnamed one; `rings`, `rows`,
+    /// `columns`, `order`, `echoes`, `mean_error_deg`; None where `rig` or `calibration` named
+    /// the sensor, or none was recovered), `path` (`"unfolded"`, `"beam-table"`, `"ring-field"`,
+    /// `"organized"`; None for one of our own files kept as written), the counts (`points`,
+    /// `placed`, `moved`, `stacked`, `shared`, `outside`, `skipped`, `no_returns`, `rings_found`),
+    /// `fallback`, `rows`, `cols`, `planes`, and where the frame came from (`file`, `layout`,
+    /// `layout_description`, `layout_by`: `"name"`, `"content"` or `"flag"` for `layout=`; `topic`,
+    /// `message` for a bag's message). None for scans and frames read with `ordered=False`.
+    #[getter]
+    fn ordering<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.ordering.as_ref().map(|o| o.to_dict(py)).transpose()
+    }
+
+    /// The cell of each point of the file (or message) read, in the file's own point order: an
+    /// int64 `(N,)` array of flat cell indices into the `(H, W)` grid (`frame.xyz.reshape(-1,
+    /// 3)[cell]`), -1 for a point ordering skipped (NaN coordinates, a no-return). None for scans,
+    /// frames read with `ordered=False` and our own files kept as written (their points are the
+    /// cells).
+    #[getter]
+    fn cell_of_point<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyAny>> {
+        let report = self.ordering.as_ref()?.report.as_ref()?;
+        let cells: Vec<i64> = report.cell_of_point.iter().map(|c| c.map_or(-1, i64::from)).collect();
+        Some(PyArray1::from_vec(py, cells).into_any())
+    }
+
+    /// Decisions over the cells (a bool `(H, W)` array, as `classify()` returns) as one uint8 per
+    /// point of the file read, in the file's own point order, 1 = ground (0 for points ordering
+    /// skipped): the bytes `groundtruth classify` writes to `frame_NNNNNN.ground`. For a frame not
+    /// reordered (a scan, `ordered=False`, our own files) one byte per cell.
+    fn decisions_per_point<'py>(&self, py: Python<'py>, decisions: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let cells = cell_decisions(self, decisions)?;
+        let bytes = match &self.ordering {
+            Some(o) => o.decisions_per_point(&cells),
+            None => cells.iter().map(|&g| u8::from(g)).collect(),
+        };
+        Ok(PyArray1::from_vec(py, bytes).into_any())
     }
 
     fn __repr__(&self) -> String {

@@ -11,6 +11,7 @@ mod error;
 mod eval_dataset;
 mod frame;
 mod io;
+mod ordering;
 mod score;
 
 use std::sync::Arc;
@@ -119,7 +120,7 @@ fn scan<'py>(
     let s = s.ideal(ideal);
     s.spec().validate().map_err(scenario_error)?;
     let scan = Arc::new(py.detach(move || s.scan()).map_err(scenario_error)?);
-    Ok((0..scan.frames().len()).map(|k| Frame { scan: scan.clone(), k }).collect())
+    Ok((0..scan.frames().len()).map(|k| Frame { scan: scan.clone(), k, ordering: None }).collect())
 }
 
 /// Benchmark helper: the same scan as `scan(scene, rig, ideal=ideal)` through the Rust API alone

@@ -163,11 +163,15 @@ def test_bad_files(frame, tmp_path):
 
 
 def test_classify_an_unorganized_file_is_refused_not_crashed(tmp_path):
-    # A KITTI .bin reads back as a 1 x N cloud in file order; our methods need the grid (the
-    # command line's `classify` recovers it from real recordings first).
+    # A KITTI .bin read as stored is a 1 x N cloud in file order; our methods need the grid (read
+    # ordered, the default, recovers it as the command line's `classify` does).
     (f,) = gt.scan("flat", "vlp16-roof")
     gt.write(f, tmp_path / "f.bin")
-    back = gt.read(tmp_path / "f.bin")
+    back = gt.read(tmp_path / "f.bin", ordered=False)
     assert back.shape == (1, f.returns)
     with pytest.raises(ValueError, match="too small"):
         gt.classify(back)
+    # Ordered: `flat` lights the lower 8 of the 16 beams, an unnamed 8-ring sensor, as the CLI says.
+    ordered = gt.read(tmp_path / "f.bin")
+    assert ordered.shape == (8, f.cols) and ordered.ordering["sensor"]["model"] is None
+    assert gt.classify(ordered).shape == ordered.shape
