@@ -12,7 +12,10 @@
 # Usage: scenario/check_readme_example.sh [README.md]
 # Environment: CARGO_TARGET_DIR (default: <workspace>/target-example, removed afterwards unless
 # KEEP_TARGET=1; CI passes the workspace's target dir so that dependencies of equal versions are
-# not built twice), OFFLINE=1 to pass --offline to cargo.
+# not built twice), OFFLINE=1 to pass --offline to cargo, WORKSPACE_PROFILE=1 to build with the
+# workspace's per-package `[profile.dev.package]` opt-levels on top of the user's (`--config`; the
+# user's Cargo.toml stays verbatim): proc macros and cold crates built alike, so the dependencies
+# the workspace's test build compiled are reused instead of compiled again.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -84,6 +87,15 @@ if [ -n "$glams" ]; then
 fi
 cargo tree "${offline[@]}" -e normal -i glam --depth 0 --prefix none --format '{p}'
 
+config=()
+if [ "${WORKSPACE_PROFILE:-0}" = 1 ]; then
+    # The `[profile.dev.package]` table of the workspace's Cargo.toml, up to the next table.
+    awk '/^\[profile\.dev\.package\]$/ { f = 1; print; next } f && /^\[/ { exit } f' "$root/Cargo.toml" \
+        > "$work/workspace-profile.toml"
+    grep -q '^"\*"' "$work/workspace-profile.toml" || {
+        echo "error: no [profile.dev.package] table with \"*\" in $root/Cargo.toml" >&2; exit 1; }
+    config=(--config "$work/workspace-profile.toml")
+fi
 echo "== cargo test in the user's crate"
-CARGO_TARGET_DIR="$target" cargo test "${offline[@]}" --test ground_scenarios
+CARGO_TARGET_DIR="$target" cargo test "${offline[@]}" "${config[@]}" --test ground_scenarios
 echo "README example: OK ($(grep -c '#\[test\]' tests/ground_scenarios.rs) tests, one glam)"
