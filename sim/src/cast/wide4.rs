@@ -1,6 +1,8 @@
 //! A 4-wide BVH collapsed from an obvhs `Bvh2`, with a closest-hit traversal that tests the four
 //! child boxes of a node together (structure-of-arrays, so the slab tests vectorise) and visits
-//! children nearest first. Triangles are stored in the order the leaves are laid out.
+//! children nearest first. Triangles are stored in the order the leaves are laid out, and each
+//! leaf's triangles again four to a SIMD pack ([`TriPack`], `tri_pack.rs`): one ray tests a leaf
+//! of up to four triangles at once.
 //!
 //! Collapse rule: starting from a binary node's two children, the inner child with the largest
 //! surface area is replaced by its own two children until there are four or only leaves remain.
