@@ -246,6 +246,45 @@ fn bvh_fans_match_parry_on_lidar_rays() {
     }
 }
 
+/// The closest hit by testing every triangle: the smallest `t`, of equal `t` the lowest mesh index.
+fn brute_force(mesh: &SceneMesh, ray: &Ray) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    for i in 0..mesh.len() {
+        if let Some(t) = intersect_triangle(ray, mesh.triangle(i))
+            && best.is_none_or(|b| t < b.t)
+        {
+            best = Some(Hit { t, triangle: i as u32 });
+        }
+    }
+    best
+}
+
+/// Every traversal of the 4-wide tree (fans of 4 to 32 rays, one ray at a time, with and without the
+/// previous hit as a seed) reports exactly the hit of the brute-force loop over all triangles, `t`
+/// bit for bit and the same triangle, on coherent LiDAR fans (one origin and per-laser origins) and on
+/// random rays: the leaves' four-triangle tests and the fans' interval tests change nothing.
+#[test]
+fn bvh_hits_equal_brute_force_bit_for_bit() {
+    let mesh = random_scene(31);
+    let mut rays = lidar_rays(&[Vec3::new(0.5, 0.25, 3.0)], 8, 8, f32::INFINITY, 0.0);
+    rays.extend(lidar_rays(&[Vec3::new(-6.0, 4.0, 1.5)], 16, 8, 40.0, 0.03));
+    rays.extend(random_rays(12, 2_000));
+    let expected: Vec<Option<(u32, u32)>> =
+        rays.iter().map(|r| brute_force(&mesh, r).map(|h| (h.t.to_bits(), h.triangle))).collect();
+    let hits = expected.iter().filter(|h| h.is_some()).count();
+    assert!(hits > 2_000 && hits < rays.len() - 500, "{hits} hits of {}: not a mixed set", rays.len());
+    for (packet_rays, coherent) in [(0, false), (0, true), (4, false), (8, true), (16, false), (32, false)] {
+        let bvh = BvhCaster::with_options(&mesh, BvhOptions { packet_rays, coherent, ..BvhOptions::default() });
+        let bits = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.triangle));
+        let batch: Vec<_> = bvh.cast_all(&rays).into_iter().map(bits).collect();
+        let single: Vec<_> = rays.iter().map(|r| bits(bvh.cast(r))).collect();
+        for (i, want) in expected.iter().enumerate() {
+            assert_eq!(batch[i], *want, "packet_rays {packet_rays}, coherent {coherent}: ray {i} {:?}", rays[i]);
+            assert_eq!(single[i], *want, "one ray at a time: ray {i} {:?}", rays[i]);
+        }
+    }
+}
+
 #[test]
 fn cast_all_is_identical_on_one_and_two_threads() {
     let mesh = random_scene(21);

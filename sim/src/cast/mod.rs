@@ -9,6 +9,7 @@ pub mod fixture;
 pub mod gpu;
 #[cfg(feature = "reference")]
 mod reference;
+mod tri_pack;
 pub mod watertight;
 mod wide4;
 

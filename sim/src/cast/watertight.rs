@@ -93,6 +93,14 @@ impl RayPre {
             return None;
         }
         let t_scaled = u * (self.sz * az) + v * (self.sz * bz) + w * (self.sz * cz);
+        Self::distance(t_scaled, det, t_limit)
+    }
+
+    /// The last step of [`RayPre::intersect`]: the distance `t_scaled / det` (`det` non-zero) when
+    /// it lies in `(0, t_limit]`, else `None`. Shared with the four-triangle test of `tri_pack.rs`,
+    /// so both decide with the same operations.
+    #[inline(always)]
+    pub(super) fn distance(t_scaled: f32, det: f32, t_limit: f32) -> Option<f32> {
         // 0 < t_scaled / det <= t_limit, without dividing.
         let in_range = if det > 0.0 {
             t_scaled > 0.0 && t_scaled <= t_limit * det

@@ -1,6 +1,8 @@
 //! A 4-wide BVH collapsed from an obvhs `Bvh2`, with a closest-hit traversal that tests the four
 //! child boxes of a node together (structure-of-arrays, so the slab tests vectorise) and visits
-//! children nearest first. Triangles are stored in the order the leaves are laid out.
+//! children nearest first. Triangles are stored in the order the leaves are laid out, and each
+//! leaf's triangles again four to a SIMD pack ([`TriPack`], `tri_pack.rs`): one ray tests a leaf
+//! of up to four triangles at once.
 //!
 //! Collapse rule: starting from a binary node's two children, the inner child with the largest
 //! surface area is replaced by its own two children until there are four or only leaves remain.
@@ -8,6 +10,7 @@
 use glam::Vec3;
 use obvhs::bvh2::Bvh2;
 
+use super::tri_pack::TriPack;
 use super::watertight::RayPre;
 
 /// Marks an unused child slot.
@@ -18,7 +21,7 @@ const EMPTY: u32 = u32::MAX;
 struct Node4 {
     /// `bounds[a][k]`: axis `a` minimum (a = 0..3) and maximum (a = 3..6) of child `k`.
     bounds: [[f32; 4]; 6],
-    /// Inner child: node index; leaf child: first triangle (in layout order).
+    /// Inner child: node index; leaf child: its first [`TriPack`].
     child: [u32; 4],
     /// 0 for an inner child, the triangle count for a leaf, [`EMPTY`] for an unused slot.
     count: [u32; 4],
@@ -37,9 +40,11 @@ pub(super) struct Wide4 {
     nodes: Vec<Node4>,
     /// Triangle corners in layout order.
     pub(super) tris: Vec<[Vec3; 3]>,
+    /// Each leaf's triangles, four to a pack (a leaf's packs are consecutive).
+    packs: Vec<TriPack>,
     /// Layout order -> index into the mesh's triangles.
     pub(super) order_to_triangle: Vec<u32>,
-    /// The root is a single leaf (tiny meshes): `(first, count)`.
+    /// The root is a single leaf (tiny meshes): `(first pack, triangle count)`.
     root_leaf: Option<(u32, u32)>,
 }
 
@@ -55,7 +60,13 @@ struct RayBox {
 impl Wide4 {
     /// Collapses `bvh2` (with `primitive_indices` into `tris_of_mesh`) into a 4-wide BVH.
     pub(super) fn from_bvh2(bvh2: &Bvh2, tri_of: impl Fn(u32) -> [Vec3; 3]) -> Self {
-        let mut w = Self { nodes: Vec::new(), tris: Vec::new(), order_to_triangle: Vec::new(), root_leaf: None };
+        let mut w = Self {
+            nodes: Vec::new(),
+            tris: Vec::new(),
+            packs: Vec::new(),
+            order_to_triangle: Vec::new(),
+            root_leaf: None,
+        };
         if bvh2.nodes.is_empty() {
             return w;
         }
@@ -70,15 +81,19 @@ impl Wide4 {
         w
     }
 
+    /// Appends the triangles of the binary leaf `node` and their packs; returns the first pack.
     fn emit_leaf(&mut self, bvh2: &Bvh2, node: usize, tri_of: &impl Fn(u32) -> [Vec3; 3]) -> u32 {
         let n = &bvh2.nodes[node];
-        let first = self.tris.len() as u32;
+        let first = self.tris.len();
         for i in n.first_index..n.first_index + n.prim_count {
             let prim = bvh2.primitive_indices[i as usize];
             self.tris.push(tri_of(prim));
             self.order_to_triangle.push(prim);
         }
-        first
+        let first_pack = self.packs.len() as u32;
+        let packs = TriPack::pack(&self.tris[first..], first as u32).collect::<Vec<_>>();
+        self.packs.extend(packs);
+        first_pack
     }
 
     /// Fills node `slot` of `self` from the binary inner node `node`.
@@ -133,7 +148,7 @@ impl Wide4 {
         let mut best = seed;
         let mut best_t = seed.map_or(pre.t_max, |s| s.1);
         if let Some((first, count)) = self.root_leaf {
-            Self::leaf(tris, &self.order_to_triangle, pre, first, count, &mut best, &mut best_t);
+            self.leaf(tris, pre, first, count, &mut best, &mut best_t);
             return best;
         }
         if self.nodes.is_empty() {
@@ -163,7 +178,7 @@ impl Wide4 {
                     inner[q] = (n.child[k], t);
                     q += 1;
                 } else if t <= best_t {
-                    Self::leaf(tris, &self.order_to_triangle, pre, n.child[k], n.count[k], &mut best, &mut best_t);
+                    self.leaf(tris, pre, n.child[k], n.count[k], &mut best, &mut best_t);
                 }
             }
             // Descend into the nearest inner child; push the others farthest first.
@@ -174,33 +189,34 @@ impl Wide4 {
         }
     }
 
-    /// The closest hit among a leaf's triangles; of triangles at exactly the same distance (a
-    /// shared edge, coplanar overlapping faces), the one with the lowest mesh index, so that every
-    /// layout of the tree and the GPU backend report the same triangle (and label).
+    /// The closest hit among a leaf's `count` triangles (packs from `first_pack` on, tested in
+    /// layout order); of triangles at exactly the same distance (a shared edge, coplanar overlapping
+    /// faces), the one with the lowest mesh index, so that every layout of the tree and the GPU
+    /// backend report the same triangle (and label).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn leaf(
+        &self,
         tris: &[[Vec3; 3]],
-        ids: &[u32],
         pre: &RayPre,
-        first: u32,
+        first_pack: u32,
         count: u32,
         best: &mut Option<(u32, f32)>,
         best_t: &mut f32,
     ) {
-        for i in first..first + count {
-            let [a, b, c] = tris[i as usize];
+        let ids = &self.order_to_triangle;
+        let first_pack = first_pack as usize;
+        for pack in &self.packs[first_pack..first_pack + count.div_ceil(4) as usize] {
             // `intersect` keeps `t <= best_t`: a tie is `t == best_t`.
-            if let Some(t) = pre.intersect(a, b, c, *best_t) {
+            pack.intersect(pre, tris, best_t, |i, t| {
                 let better = match *best {
                     None => true,
                     Some((j, bt)) => t < bt || ids[i as usize] < ids[j as usize],
                 };
                 if better {
                     *best = Some((i, t));
-                    *best_t = t;
                 }
-            }
+                better
+            });
         }
     }
 }
@@ -322,8 +338,7 @@ impl Wide4 {
                         leaf_hits.get_or_insert_with(|| std::array::from_fn(|r| slab4(n, &rbs[r], best_t[r]).1));
                     for r in 0..N {
                         if per_ray[r][k] {
-                            let ids = &self.order_to_triangle;
-                            Self::leaf(tris, ids, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
+                            self.leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
                         }
                     }
                     far_t = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
