@@ -172,7 +172,9 @@ pitch_deg = [-2.0, -1.0, 0.0, 1.0, 2.0]
     let summary = ok(sweep(&["--config", s(&cfg), "--out", s(&out), "--resume", "--threads", "2"]));
     let summary: serde_json::Value = serde_json::from_str(summary.trim()).unwrap();
     let already = summary["already_done"].as_u64().unwrap();
-    assert!(already >= 5 && summary["ran"].as_u64().unwrap() == 240 - already, "{summary}");
+    // At least 5 configurations had their rows in results.csv; a configuration counts as done only
+    // once its results.jsonl rows follow (written after the CSV's), so the kill may cut the last one.
+    assert!(already >= 4 && summary["ran"].as_u64().unwrap() == 240 - already, "{summary}");
     let resumed = sorted_lines(&csv);
     let mut unique = resumed.clone();
     unique.dedup();
