@@ -335,10 +335,8 @@ impl Frame {
     /// reordered (a scan, `ordered=False`, our own files) one byte per cell.
     fn decisions_per_point<'py>(&self, py: Python<'py>, decisions: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let cells = cell_decisions(self, decisions)?;
-        let bytes = match &self.ordering {
-            Some(o) => o.decisions_per_point(&cells),
-            None => cells.iter().map(|&g| u8::from(g)).collect(),
-        };
+        let report = self.ordering.as_ref().and_then(|o| o.report.as_ref());
+        let bytes = classifier::ordering::decisions_per_input_point(report, &cells);
         Ok(PyArray1::from_vec(py, bytes).into_any())
     }
 

@@ -128,11 +128,14 @@ fn recording_error(e: RecordingError, path: &Path) -> PyErr {
         ),
         e @ RecordingError::LayoutOfNonRaw { .. } => value_error("layout", e),
         e @ RecordingError::CalibrationRows { .. } => value_error("calibration", e),
-        e @ (RecordingError::Ordering { .. } | RecordingError::Message { .. }) => {
-            value_error("path", format!("{e} (ordered=False reads it as stored; rig= or calibration= name the sensor)"))
-        }
+        e @ (RecordingError::Ordering { .. } | RecordingError::Message { .. }) => unorderable(e),
         e => value_error("path", e),
     }
+}
+
+/// A file or message whose order cannot be recovered, as `ValueError` naming `path` and the ways on.
+fn unorderable(e: RecordingError) -> PyErr {
+    value_error("path", format!("{e} (ordered=False reads it as stored; rig= or calibration= name the sensor)"))
 }
 
 /// The PointCloud2 messages of a bag's topic as Frames: ordered with `setup` (messages that cannot
@@ -143,9 +146,7 @@ fn read_bag(py: Python<'_>, path: &Path, topic: Option<String>, setup: Option<Se
     let p = path.to_path_buf();
     let bag_error = |e: RecordingError| match e {
         RecordingError::Topic(m) => value_error("topic", m),
-        e @ (RecordingError::Ordering { .. } | RecordingError::Message { .. }) => {
-            value_error("path", format!("{e} (ordered=False reads it as stored; rig= or calibration= name the sensor)"))
-        }
+        e @ (RecordingError::Ordering { .. } | RecordingError::Message { .. }) => unorderable(e),
         e => value_error("path", e),
     };
     let read = py.detach(move || -> PyResult<(Vec<Read>, Vec<String>)> {

@@ -1,8 +1,7 @@
 //! How a frame read with `read(..., ordered=True)` was put into rings and columns: the library's
 //! ordering report ([`classifier::ordering::OrderingReport`]) and where the frame came from
-//! ([`classifier::recording::Provenance`]), as `Frame.ordering` (a dict) and
-//! `Frame.decisions_per_point` (the decisions in the file's own point order, as the command line's
-//! `.ground` files hold them).
+//! ([`classifier::recording::Provenance`]), as `Frame.ordering` (a dict); its report maps
+//! `Frame.decisions_per_point` to the file's own point order.
 
 use classifier::ordering::OrderingReport;
 use classifier::recording::Provenance;
@@ -36,7 +35,7 @@ impl ReadOrdering {
     pub fn summary(&self) -> String {
         let (rows, cols, planes) = self.grid;
         match &self.report {
-            Some(r) => format!("ordered into {rows} x {cols} x {planes}: {}", r.summary()),
+            Some(r) => r.grid_line(rows, cols, planes),
             None => format!("kept as written ({rows} x {cols} x {planes}: already in ring x column order)"),
         }
     }
@@ -72,15 +71,5 @@ impl ReadOrdering {
         // Through Python's json module: plain dicts, lists, numbers, strings and None.
         let text = serde_json::to_string(&doc).map_err(|e| value_error("ordering", e))?;
         py.import("json")?.call_method1("loads", (text,))
-    }
-
-    /// Per-cell decisions as one byte per input point in the file's (or message's) own order, 1 =
-    /// ground, skipped points 0 ([`classifier::ordering::decisions_per_point`]); cell by cell for a
-    /// frame kept as written, as the command line writes them.
-    pub fn decisions_per_point(&self, ground: &[bool]) -> Vec<u8> {
-        match &self.report {
-            Some(r) => classifier::ordering::decisions_per_point(r, ground),
-            None => ground.iter().map(|&g| u8::from(g)).collect(),
-        }
     }
 }

@@ -153,10 +153,7 @@ fn run_files(args: &Args, recording: &Recording) -> anyhow::Result<()> {
             let read_ms = reader.read(path, &setup)?;
             let t2 = Instant::now();
             let out = method.classify(&FrameInput { index, cloud: reader.cloud(), world_from_vehicle: None })?;
-            let bytes = match reader.report() {
-                Some(r) => classifier::ordering::decisions_per_point(r, &out),
-                None => out.iter().map(|&g| u8::from(g)).collect(),
-            };
+            let bytes = classifier::ordering::decisions_per_input_point(reader.report(), &out);
             cls.push(ms(t2));
             total.push(ms(t0));
             for (name, s) in method.named_stage_times() {

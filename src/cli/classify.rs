@@ -94,14 +94,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             println!("{line}");
         }
         if let Some(r) = report {
-            println!(
-                "{}: ordered into {} x {} x {}: {}",
-                path.display(),
-                cloud.rows,
-                cloud.cols,
-                cloud.planes,
-                r.summary()
-            );
+            println!("{}: {}", path.display(), r.grid_line(cloud.rows, cloud.cols, cloud.planes));
         }
         let ground = method
             .classify(&FrameInput { index: f.index, cloud, world_from_vehicle: f.world_from_vehicle })

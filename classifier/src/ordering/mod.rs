@@ -225,3 +225,13 @@ pub fn decisions_per_point(report: &OrderingReport, ground: &[bool]) -> Vec<u8> 
         .map(|c| c.map_or(0, |c| u8::from(ground.get(c as usize).copied().unwrap_or(false))))
         .collect()
 }
+
+/// Decisions per cell as one byte per input point in the input's own order (1 = ground): through
+/// the ordering `report` where there is one ([`decisions_per_point`]), else cell by cell (an input
+/// kept as written, one of our own files).
+pub fn decisions_per_input_point(report: Option<&OrderingReport>, ground: &[bool]) -> Vec<u8> {
+    match report {
+        Some(r) => decisions_per_point(r, ground),
+        None => ground.iter().map(|&g| u8::from(g)).collect(),
+    }
+}

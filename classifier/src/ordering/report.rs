@@ -73,6 +73,12 @@ impl OrderingReport {
         self.placed + self.moved + self.stacked + self.shared
     }
 
+    /// The line `groundtruth classify` prints for a frame ordered into `rows x cols x planes`:
+    /// `ordered into R x C x P: ` and [`OrderingReport::summary`].
+    pub fn grid_line(&self, rows: usize, cols: usize, planes: usize) -> String {
+        format!("ordered into {rows} x {cols} x {planes}: {}", self.summary())
+    }
+
     /// One line for the command line.
     pub fn summary(&self) -> String {
         let mut s = format!(

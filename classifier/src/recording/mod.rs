@@ -60,7 +60,7 @@ pub use provenance::Provenance;
 
 use crate::dataset::{DatasetError, DatasetLayout};
 use crate::error::ClassifyError;
-use crate::ordering::{OrderingReport, SensorSetup, decisions_per_point};
+use crate::ordering::{OrderingReport, SensorSetup, decisions_per_input_point};
 use labelled::DatasetSource;
 
 /// Why a recording, or one of its frames, could not be read.
@@ -380,10 +380,7 @@ impl Frame<'_> {
     /// Decisions per cell of [`Frame::cloud`] as one byte per input point in the input's own order
     /// (1 = ground): through the ordering report where there is one, else cell by cell.
     pub fn decisions_per_point(&self, ground: &[bool]) -> Vec<u8> {
-        match self.report {
-            None => ground.iter().map(|&g| u8::from(g)).collect(),
-            Some(r) => decisions_per_point(r, ground),
-        }
+        decisions_per_input_point(self.report, ground)
     }
 }
 

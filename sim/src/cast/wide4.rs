@@ -91,8 +91,7 @@ impl Wide4 {
             self.order_to_triangle.push(prim);
         }
         let first_pack = self.packs.len() as u32;
-        let packs = TriPack::pack(&self.tris[first..], first as u32).collect::<Vec<_>>();
-        self.packs.extend(packs);
+        self.packs.extend(TriPack::pack(&self.tris[first..], first as u32));
         first_pack
     }
 
