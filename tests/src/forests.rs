@@ -3,6 +3,7 @@
 //! branches/leaves), next to the "sensed points" of the paper's Tables I-III. Used by the
 //! `forest_shares` example (prints the table) and by `tests/forests.rs` (asserts it).
 
+use sim::scan::{PreparedScene, Scanner};
 use sim::{OrderedCloud, Rig, SemanticClass};
 
 /// The four categories of seed 002's hand labels, in table order.
@@ -130,10 +131,29 @@ impl Counts {
 /// Scans bundled `scene` at `seed` with `rig` standing at the ego origin (one frame, default
 /// measurement: range noise on, as users get it) and counts the returns.
 pub fn measure(scene: &str, rig: &Rig, seed: u64) -> Counts {
+    measure_rigs(scene, std::slice::from_ref(rig), seed)[0]
+}
+
+/// [`measure`] with each of `rigs` in turn, the scene generated and its caster built once (the
+/// same counts as one [`measure`] per rig: the caster is built from the same mesh either way).
+pub fn measure_rigs(scene: &str, rigs: &[Rig], seed: u64) -> Vec<Counts> {
     let spec = crate::ScanSpec { scene: scene.to_string(), seed, ..crate::ScanSpec::default() };
     let s = spec.load_scene().unwrap_or_else(|e| panic!("{scene}: {e}"));
-    let frames = crate::scan_on(&s, rig, &spec);
-    Counts::of(&frames[0].cloud)
+    let mut prepared: Option<PreparedScene> = None;
+    rigs.iter()
+        .map(|rig| {
+            let setup = spec.setup_with_rig(&s, rig.clone()).unwrap_or_else(|e| panic!("{scene}: {e}"));
+            let prepared = match &mut prepared {
+                Some(p) => p,
+                None => prepared.insert(
+                    PreparedScene::new(&s.mesh, setup.config.backend).unwrap_or_else(|e| panic!("{scene}: {e}")),
+                ),
+            };
+            let scanner = Scanner::with_prepared(&s.mesh, &setup.rig, setup.config.clone(), prepared)
+                .unwrap_or_else(|e| panic!("{scene}: {e}"));
+            Counts::of(&scanner.frame(0).cloud)
+        })
+        .collect()
 }
 
 /// How far a measured frame is from the paper: per category the relative error of the share

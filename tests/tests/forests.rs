@@ -48,11 +48,10 @@ fn nodding_scans_of_the_forests_give_the_papers_shares() {
 
 #[test]
 fn every_roof_rig_sees_ground_around_the_vehicle_in_every_forest() {
-    for name in ROOF_RIGS {
-        let rig = sim::Rig::preset(name).unwrap();
-        for paper in &PAPER {
-            for seed in SEEDS {
-                let c = forests::measure(paper.scene, &rig, seed);
+    let rigs: Vec<sim::Rig> = ROOF_RIGS.iter().map(|name| sim::Rig::preset(name).unwrap()).collect();
+    for paper in &PAPER {
+        for seed in SEEDS {
+            for (name, c) in ROOF_RIGS.iter().zip(forests::measure_rigs(paper.scene, &rigs, seed)) {
                 let near = c.near_ground as f64 / c.returns as f64;
                 eprintln!(
                     "{name} {} seed {seed}: {} returns, ground {:.3}, within {NEAR_M} m {near:.3}",
