@@ -1,4 +1,4 @@
-//! Every reader (PCD, PLY cloud, PLY mesh, KITTI `.bin` + `.label`) given arbitrary bytes, a
+//! Every reader (PCD, PLY cloud, PLY mesh, KITTI `.bin` + `.label`, LAS) given arbitrary bytes, a
 //! truncated valid file or a valid file with corrupted bytes returns a value or an error, never
 //! panics; and a truncated binary file is always refused.
 
@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::Vec3;
 use proptest::prelude::*;
-use sim::io::{kitti, pcd, ply};
+use sim::io::{kitti, las, pcd, ply};
 use sim::scene::ply::{read_mesh_bytes, write_mesh};
 use sim::{OrderedCloud, SceneMesh, SemanticClass, Surface};
 
@@ -39,6 +39,7 @@ fn valid_files() -> Vec<(&'static str, Vec<u8>)> {
         ("ply", ply::encode(&c).unwrap().0),
         ("mesh", std::fs::read(&mesh_path).unwrap()),
         ("kitti", kitti_both),
+        ("las", las::encode(Path::new("x.las"), &c).unwrap().0),
     ]
 }
 
@@ -49,6 +50,7 @@ fn read_any(kind: &str, bytes: &[u8]) -> bool {
         "pcd" => pcd::read_bytes(p, bytes).is_ok(),
         "ply" => ply::read_bytes(p, bytes).is_ok(),
         "mesh" => read_mesh_bytes(p, bytes).is_ok(),
+        "las" => las::read_bytes(p, bytes).is_ok(),
         _ => {
             // Split the bytes into a .bin part (multiple of 16 when possible) and a .label part.
             let split = bytes.len() * 4 / 5 / 16 * 16;
@@ -62,18 +64,18 @@ fn read_any(kind: &str, bytes: &[u8]) -> bool {
     }
 }
 
-const KINDS: [&str; 4] = ["pcd", "ply", "mesh", "kitti"];
+const KINDS: [&str; 5] = ["pcd", "ply", "mesh", "kitti", "las"];
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
 
     #[test]
-    fn arbitrary_bytes_never_panic(kind in 0usize..4, bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
+    fn arbitrary_bytes_never_panic(kind in 0usize..5, bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
         read_any(KINDS[kind], &bytes);
     }
 
     #[test]
-    fn header_prefixed_garbage_never_panics(which in 0usize..5, keep in 0usize..400, tail in proptest::collection::vec(any::<u8>(), 0..300)) {
+    fn header_prefixed_garbage_never_panics(which in 0usize..6, keep in 0usize..400, tail in proptest::collection::vec(any::<u8>(), 0..300)) {
         let files = valid_files();
         let (kind, bytes) = &files[which];
         let mut b = bytes[..keep.min(bytes.len())].to_vec();
@@ -82,7 +84,7 @@ proptest! {
     }
 
     #[test]
-    fn truncations_are_refused(which in 0usize..5, cut in 1usize..2000) {
+    fn truncations_are_refused(which in 0usize..6, cut in 1usize..2000) {
         let files = valid_files();
         let (kind, bytes) = &files[which];
         prop_assert!(read_any(kind, bytes), "the untouched file reads");
@@ -96,7 +98,7 @@ proptest! {
     }
 
     #[test]
-    fn corrupted_bytes_never_panic(which in 0usize..5, edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
+    fn corrupted_bytes_never_panic(which in 0usize..6, edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
         let files = valid_files();
         let (kind, bytes) = &files[which];
         let mut b = bytes.clone();
