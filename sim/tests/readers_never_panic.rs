@@ -109,3 +109,22 @@ proptest! {
         read_any(kind, &b);
     }
 }
+
+/// The `mcap_bag` fuzz target's crash of 2026-11-28 (98 bytes): an Attachment record shorter than
+/// its header, which the footer's summary start points at; mcap 0.26's `parse_record` sliced past
+/// its end (a panic). Now the summary is passed over and the read-through refuses the record.
+#[test]
+fn bag_with_a_short_attachment_is_refused() {
+    let bytes: [u8; 110] = [
+        137, 77, 67, 65, 80, 48, 13, 10, 9, 33, 0, 0, 0, 0, 0, 0, 0, 36, 4, 0, 163, 0, 0, 0, 65, 80, 48, 13, 0, 0, 43,
+        3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 115, 137, 80, 10, 1, 23, 0, 137, 77, 67, 0, 0, 5, 0, 0, 0, 0, 0, 0,
+        232, 218, 153, 143, 97, 98, 105, 0, 0, 2, 20, 0, 0, 0, 0, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0, 41, 243, 255, 13, 0,
+        0, 0, 0, 184, 1, 118, 219, 137, 77, 67, 65, 80, 48, 13, 10,
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("short_attachment.mcap");
+    std::fs::write(&path, bytes).unwrap();
+    let bag = sim::io::ros2::Bag::open(&path).unwrap();
+    let e = bag.topics().unwrap_err().to_string();
+    assert!(e.contains("attachment record shorter") && e.contains("short_attachment.mcap"), "{e}");
+}
