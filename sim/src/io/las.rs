@@ -21,7 +21,7 @@
 //! - one extra-bytes field `instance` (uint32, described by a LASF_Spec record 4 VLR, which
 //!   laspy and PDAL read as a named dimension).
 
-use std::io::Cursor;
+use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use las::point::Format;
@@ -147,11 +147,78 @@ const LAZ_MAX_RATIO: u64 = 64;
 /// exactly 4 (our `instance` field), `range_m` = distance from the origin, `column` = point index.
 /// A malformed file is an error naming it.
 pub fn read(path: &Path) -> Result<OrderedCloud> {
-    let mut reader = las::Reader::from_path(path).map_err(|e| las_err(path, e))?;
+    let file = std::fs::File::open(path).map_err(|e| las_err(path, e.into()))?;
+    let file_len = file.metadata().map_err(|e| SimError::io(path, e))?.len();
+    read_from(path, std::io::BufReader::new(file), file_len)
+}
+
+/// [`read`] on the bytes of a LAS file already in memory (copied once: the `las` crate's reader
+/// owns its input); `path` only names the file in errors.
+pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
+    read_from(path, Cursor::new(bytes.to_vec()), bytes.len() as u64)
+}
+
+/// Bytes of an extended VLR's header (LAS 1.4 table 10): its data follows.
+const EVLR_HEADER_BYTES: u64 = 60;
+
+/// Refuses, before the `las` crate reads the header, the counts that would make it allocate more
+/// than the file holds or overflow: a LAS 1.4 header's first extended VLR whose record length is
+/// past the end of the file (the crate zero-fills a buffer of the declared length, up to 2^64
+/// bytes: an abort), and point records whose bytes overflow 64 bits (the crate multiplies and adds
+/// them unchecked: a panic where overflow checks are on). Leaves `input` at its start; a header too
+/// short for these fields is left to the crate to refuse.
+fn check_counts_fit<R: Read + Seek>(path: &Path, input: &mut R, file_len: u64) -> Result<()> {
+    let io = |e| SimError::io(path, e);
+    let mut head = Vec::with_capacity(255);
+    input.by_ref().take(255).read_to_end(&mut head).map_err(io)?;
+    let u16_at = |at: usize| u16::from_le_bytes([head[at], head[at + 1]]);
+    let u32_at = |at: usize| u32::from_le_bytes(head[at..at + 4].try_into().unwrap_or_default());
+    let u64_at = |at: usize| u64::from_le_bytes(head[at..at + 8].try_into().unwrap_or_default());
+    if head.len() < 111 || &head[..4] != b"LASF" {
+        input.rewind().map_err(io)?;
+        return Ok(());
+    }
+    // LAS 1.4 table 3: offset to point data at 96, record length at 105, legacy count at 107; for
+    // 1.4 and later, first EVLR start at 235, EVLR count at 243, 64-bit point count at 247.
+    let large = head[24] == 1 && head[25] >= 4 && head.len() >= 255;
+    let legacy = u64::from(u32_at(107));
+    // The crate's rule: the legacy count when not 0, else the 64-bit one.
+    let declared = if legacy == 0 && large { u64_at(247) } else { legacy };
+    let record = u64::from(u16_at(105));
+    if declared.checked_mul(record).and_then(|b| b.checked_add(u64::from(u32_at(96)))).is_none() {
+        return Err(SimError::bad_file(
+            path,
+            format!("LAS header: {declared} point records of {record} bytes overflow 64 bits"),
+        ));
+    }
+    let (evlr_start, evlrs) = if large { (u64_at(235), u32_at(243)) } else { (0, 0) };
+    if evlr_start > 0 && evlrs > 0 && evlr_start.saturating_add(EVLR_HEADER_BYTES) <= file_len {
+        // The record length after the header: bytes 20..28 of the EVLR header.
+        input.seek(SeekFrom::Start(evlr_start + 20)).map_err(io)?;
+        let mut length = [0u8; 8];
+        input.read_exact(&mut length).map_err(io)?;
+        let length = u64::from_le_bytes(length);
+        let room = file_len - evlr_start - EVLR_HEADER_BYTES;
+        if length > room {
+            return Err(SimError::bad_file(
+                path,
+                format!(
+                    "LAS header: the extended VLR at byte {evlr_start} declares {length} bytes, more than \
+                     the {room} bytes left in the file"
+                ),
+            ));
+        }
+    }
+    input.rewind().map_err(io)
+}
+
+/// [`read`] from `input` (`file_len` bytes long); `path` only names the file in errors.
+fn read_from<R: Read + Seek + Send + Sync + 'static>(path: &Path, mut input: R, file_len: u64) -> Result<OrderedCloud> {
+    check_counts_fit(path, &mut input, file_len)?;
+    let mut reader = las::Reader::new(input).map_err(|e| las_err(path, e))?;
     // The header's point count must fit the file: `read_all` reserves what the header declares,
     // so a 300-byte file declaring billions of points would allocate gigabytes (found by the
     // `las` fuzz target). LAZ: up to `LAZ_MAX_RATIO` times smaller than its records.
-    let file_len = std::fs::metadata(path).map_err(|e| SimError::io(path, e))?.len();
     let (declared, format) = (reader.header().number_of_points(), *reader.header().point_format());
     let record = u64::from(format.len()).max(1);
     let holds = if format.is_compressed { file_len.saturating_mul(LAZ_MAX_RATIO) } else { file_len } / record;
@@ -232,5 +299,57 @@ mod tests {
         assert!(e.contains("number of point records") && e.contains("x.las"), "{e}");
         std::fs::write(&path, b"LASF truncated").unwrap();
         assert!(read(&path).unwrap_err().to_string().contains("x.las"));
+    }
+
+    /// Our file of two points, one returning per shot (the bytes [`read_bytes`] is tried on).
+    fn two_points() -> (OrderedCloud, Vec<u8>) {
+        let mut c = OrderedCloud::empty(1, 2, 1);
+        for i in 0..2 {
+            c.point_in_vehicle[i] = glam::Vec3::new(1.0 + i as f32, 2.0, -0.5);
+            c.range_m[i] = c.point_in_vehicle[i].length();
+            c.ring[i] = 3;
+            c.instance[i] = 9;
+        }
+        let (bytes, n) = encode(Path::new("x.las"), &c).unwrap();
+        assert_eq!(n, 2);
+        (c, bytes)
+    }
+
+    #[test]
+    fn read_bytes_reads_what_read_reads() {
+        let (_, bytes) = two_points();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.las");
+        std::fs::write(&path, &bytes).unwrap();
+        let (from_file, from_bytes) = (read(&path).unwrap(), read_bytes(&path, &bytes).unwrap());
+        assert_eq!(from_bytes.returns(), 2);
+        assert_eq!(from_file.point_in_vehicle, from_bytes.point_in_vehicle);
+        assert_eq!((from_file.ring, from_file.instance), (from_bytes.ring, from_bytes.instance));
+        let e = read_bytes(Path::new("y.las"), &bytes[..bytes.len() - 1]).unwrap_err().to_string();
+        assert!(e.contains("y.las"), "{e}");
+    }
+
+    #[test]
+    fn counts_past_the_file_are_refused_before_the_crate_reads_them() {
+        let (_, mut bytes) = two_points();
+        // A first extended VLR (LAS 1.4: start at byte 235, count at 243) at the end of the
+        // points declaring 2^40 bytes of data in a file of about a kilobyte.
+        let evlr_start = bytes.len() as u64;
+        bytes[235..243].copy_from_slice(&evlr_start.to_le_bytes());
+        bytes[243..247].copy_from_slice(&1u32.to_le_bytes());
+        let mut evlr = vec![0u8; EVLR_HEADER_BYTES as usize];
+        evlr[20..28].copy_from_slice(&(1u64 << 40).to_le_bytes());
+        bytes.extend_from_slice(&evlr);
+        let e = read_bytes(Path::new("e.las"), &bytes).unwrap_err().to_string();
+        assert!(e.contains("extended VLR") && e.contains("1099511627776 bytes") && e.contains("e.las"), "{e}");
+        // The same EVLR with no data: the file reads.
+        bytes[evlr_start as usize + 20..evlr_start as usize + 28].copy_from_slice(&0u64.to_le_bytes());
+        assert_eq!(read_bytes(Path::new("e.las"), &bytes).unwrap().returns(), 2);
+        // A 64-bit point count (legacy count 0) whose records overflow 64 bits.
+        let (_, mut bytes) = two_points();
+        bytes[107..111].copy_from_slice(&0u32.to_le_bytes());
+        bytes[247..255].copy_from_slice(&(u64::MAX / 2).to_le_bytes());
+        let e = read_bytes(Path::new("o.las"), &bytes).unwrap_err().to_string();
+        assert!(e.contains("overflow 64 bits") && e.contains("o.las"), "{e}");
     }
 }

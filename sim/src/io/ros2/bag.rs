@@ -498,6 +498,9 @@ impl Bag {
         let mut topics: BTreeMap<String, TopicInfo> = BTreeMap::new();
         for file in &self.files {
             let bytes = Self::read(file).ok()?;
+            if !super::stream::summary_is_safe_to_read(&bytes) {
+                return None;
+            }
             let summary = mcap::Summary::read(&bytes).ok().flatten()?;
             let counts = summary.stats.as_ref()?.channel_message_counts.clone();
             for (id, channel) in &summary.channels {

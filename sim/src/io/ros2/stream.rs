@@ -13,7 +13,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use mcap::records::Record;
+use mcap::records::{Record, op};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 /// The largest record read (1 GiB): far above any point cloud (an OS1-128 at 2048 columns with
@@ -109,6 +109,9 @@ impl<'a> Messages<'a> {
                     self.buf = &self.buf[n..];
                 }
                 Ok(LinearReadEvent::Record { data, opcode }) => {
+                    if opcode == op::ATTACHMENT && attachment_is_short(data) {
+                        return Some(Err(StreamError::corrupt("an attachment record shorter than its header and CRC")));
+                    }
                     return Some(mcap::parse_record(opcode, data).map(Record::into_owned).map_err(StreamError::from));
                 }
                 Err(e) => return Some(Err(e.into())),
@@ -116,6 +119,48 @@ impl<'a> Messages<'a> {
         }
         None
     }
+}
+
+/// Whether an Attachment record's `body` ends before its header (log and create times, name,
+/// media type, data length) and CRC: mcap 0.26's `parse_record` slices such a body past its end, a
+/// panic (found by the `mcap_bag` fuzz target). A body too short for the header's string lengths
+/// counts as short too (the crate would refuse it).
+fn attachment_is_short(body: &[u8]) -> bool {
+    let length_at = |at: usize| Some(u32::from_le_bytes(body.get(at..at.checked_add(4)?)?.try_into().ok()?) as usize);
+    let header_and_crc = (|| {
+        let media_type_at = 20usize.checked_add(length_at(16)?)?;
+        media_type_at.checked_add(4)?.checked_add(length_at(media_type_at)?)?.checked_add(8 + 4)
+    })();
+    header_and_crc.is_none_or(|n| body.len() < n)
+}
+
+/// Bytes of the footer record (opcode, length, 20-byte body) and the end magic.
+const FOOTER_AND_MAGIC_BYTES: usize = 1 + 8 + 20 + 8;
+
+/// Whether the summary section of the MCAP file `buf` (from the footer's summary start to the
+/// footer) can be handed to `mcap::Summary::read`: no Attachment record shorter than its header
+/// (see [`attachment_is_short`]) and no Chunk (whose records the crate would parse too); the spec
+/// allows neither there. A file without a footer or summary is left to the crate.
+pub(crate) fn summary_is_safe_to_read(buf: &[u8]) -> bool {
+    let Some(footer) = buf.len().checked_sub(FOOTER_AND_MAGIC_BYTES) else { return true };
+    let summary_start = u64::from_le_bytes(buf[footer + 9..footer + 17].try_into().unwrap_or_default());
+    if summary_start == 0 {
+        return true;
+    }
+    let mut at = usize::try_from(summary_start).unwrap_or(usize::MAX);
+    while let Some(head) = buf.get(at..at.saturating_add(9)) {
+        let length =
+            usize::try_from(u64::from_le_bytes(head[1..9].try_into().unwrap_or_default())).unwrap_or(usize::MAX);
+        let body = buf.get(at + 9..).unwrap_or_default();
+        match head[0] {
+            op::FOOTER => break,
+            op::CHUNK => return false,
+            op::ATTACHMENT if attachment_is_short(&body[..length.min(body.len())]) => return false,
+            _ => {}
+        }
+        at = at.saturating_add(9).saturating_add(length);
+    }
+    true
 }
 
 impl<'a> Iterator for Messages<'a> {
