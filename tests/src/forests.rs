@@ -139,17 +139,16 @@ pub fn measure(scene: &str, rig: &Rig, seed: u64) -> Counts {
 pub fn measure_rigs(scene: &str, rigs: &[Rig], seed: u64) -> Vec<Counts> {
     let spec = crate::ScanSpec { scene: scene.to_string(), seed, ..crate::ScanSpec::default() };
     let s = spec.load_scene().unwrap_or_else(|e| panic!("{scene}: {e}"));
-    let mut prepared: Option<PreparedScene> = None;
-    rigs.iter()
-        .map(|rig| {
-            let setup = spec.setup_with_rig(&s, rig.clone()).unwrap_or_else(|e| panic!("{scene}: {e}"));
-            let prepared = match &mut prepared {
-                Some(p) => p,
-                None => prepared.insert(
-                    PreparedScene::new(&s.mesh, setup.config.backend).unwrap_or_else(|e| panic!("{scene}: {e}")),
-                ),
-            };
-            let scanner = Scanner::with_prepared(&s.mesh, &setup.rig, setup.config.clone(), prepared)
+    let setups: Vec<_> = rigs
+        .iter()
+        .map(|rig| spec.setup_with_rig(&s, rig.clone()).unwrap_or_else(|e| panic!("{scene}: {e}")))
+        .collect();
+    let Some(first) = setups.first() else { return Vec::new() };
+    let prepared = PreparedScene::new(&s.mesh, first.config.backend).unwrap_or_else(|e| panic!("{scene}: {e}"));
+    setups
+        .iter()
+        .map(|setup| {
+            let scanner = Scanner::with_prepared(&s.mesh, &setup.rig, setup.config.clone(), &prepared)
                 .unwrap_or_else(|e| panic!("{scene}: {e}"));
             Counts::of(&scanner.frame(0).cloud)
         })
