@@ -100,3 +100,63 @@ fn a_shuffled_cloud_without_a_sensor_is_refused() {
     assert!(matches!(e, ClassifyError::NoOrder(RecoveryError::NoOrder { points: 20_000, .. })), "{e}");
     assert!(e.to_string().contains("no ring order can be recovered from 20000 points"), "{e}");
 }
+
+/// An HDL-32E sweep at 20 Hz stored as nuScenes stores it: every firing whole (32 points, bottom
+/// laser first, 1,085 firings), the no-returns written as `0, 0, 0` and then moved by the
+/// ego-motion compensation to where the sensor was when it fired (0.45 m behind at the first
+/// firing, at the origin at the last). Returns the records (x y z intensity), each point's laser
+/// (the nuScenes ring) and which points are such no-returns.
+fn compensated_hdl32e_sweep() -> (Vec<[f32; 4]>, Vec<u16>, Vec<bool>) {
+    let spec = sim::sensor::SensorSpec::default_for("hdl32e").unwrap();
+    let mut elevations = spec.pattern().row_elevation_rad.clone();
+    elevations.sort_by(f32::total_cmp);
+    assert_eq!(elevations.len(), 32);
+    let cols = 1085;
+    let step = std::f32::consts::TAU / cols as f32;
+    let (mut records, mut rings, mut no_return) = (Vec::new(), Vec::new(), Vec::new());
+    for col in 0..cols {
+        let az = std::f32::consts::PI - 0.5 * step - step * col as f32;
+        let behind = 0.45 * (1.0 - col as f32 / (cols - 1) as f32);
+        for (laser, &el) in elevations.iter().enumerate() {
+            // A fifth of the upper lasers' beams see nothing (sky), scattered.
+            let gone = laser >= 20 && (col * 7 + laser * 13) % 5 == 0;
+            let p = if gone {
+                Vec3::new(-0.001, -behind, -0.01 * behind)
+            } else {
+                let r = if el < -0.03 { 1.84 / (-el).sin() } else { 25.0 / el.cos() };
+                Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin()) * r
+            };
+            records.push([p.x, p.y, p.z, 10.0]);
+            rings.push(laser as u16);
+            no_return.push(gone);
+        }
+    }
+    (records, rings, no_return)
+}
+
+#[test]
+fn motion_compensated_no_returns_are_no_returns_and_a_ring_less_copy_reads_as_its_ring_field() {
+    let (records, rings, no_return) = compensated_hdl32e_sweep();
+    let gone = no_return.iter().filter(|&&g| g).count();
+    let setup = SensorSetup::default();
+    // As a nuScenes `.pcd.bin`: lasers from the ring field.
+    let (mut cloud, mut with_rings) = (CloudBuffer::default(), OrderingReport::default());
+    let attributes = PointAttributes { rings: Some(&rings), ..PointAttributes::default() };
+    setup.order_flat(&records, &attributes, &mut cloud, &mut with_rings).unwrap();
+    // As a KITTI `.bin` of the same records: a whole image stored firing by firing.
+    let (mut cloud, mut ring_less) = (CloudBuffer::default(), OrderingReport::default());
+    setup.order_kitti(&records, None, &mut cloud, &mut ring_less).unwrap();
+    for (what, report) in [("ring field", &with_rings), ("ring-less", &ring_less)] {
+        let sensor = report.sensor.as_ref().expect("recovered");
+        assert_eq!((sensor.model, sensor.columns), (Some("hdl32e"), 1085), "{what}: {}", report.summary());
+        assert_eq!((report.no_returns, report.too_near), (gone, gone), "{what}: {}", report.summary());
+        assert!((report.min_range_m - 0.9).abs() < 1e-6, "{what}: {}", report.summary());
+        assert_eq!(report.kept(), records.len() - gone, "{what}: every return kept: {}", report.summary());
+        assert!(report.placed as f64 >= 0.999 * report.kept() as f64, "{what}: {}", report.summary());
+        for (k, &g) in no_return.iter().enumerate() {
+            assert_eq!(report.cell_of_point[k].is_none(), g, "{what}: point {k}");
+        }
+    }
+    assert_eq!(ring_less.sensor.as_ref().unwrap().order, RecoveredOrder::ImageColumns);
+    assert_eq!(with_rings.cell_of_point, ring_less.cell_of_point);
+}

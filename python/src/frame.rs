@@ -308,7 +308,8 @@ impl Frame {
     /// `columns`, `order`, `echoes`, `mean_error_deg`; None where `rig` or `calibration` named
     /// the sensor, or none was recovered), `path` (`"unfolded"`, `"beam-table"`, `"ring-field"`,
     /// `"organized"`; None for one of our own files kept as written), the counts (`points`,
-    /// `placed`, `moved`, `stacked`, `shared`, `outside`, `skipped`, `no_returns`, `rings_found`),
+    /// `placed`, `moved`, `stacked`, `shared`, `outside`, `skipped`, `no_returns`, `too_near`: the
+    /// no-returns nearer than the sensor's minimum range `min_range_m`, `rings_found`),
     /// `fallback`, `rows`, `cols`, `planes`, and where the frame came from (`file`, `layout`,
     /// `layout_description`, `layout_by`: `"name"`, `"content"` or `"flag"` for `layout=`; `topic`,
     /// `message` for a bag's message). None for scans and frames read with `ordered=False`.

@@ -52,6 +52,12 @@ pub struct BeamTable {
     /// half a column either side of the centre (VLS-128, Ouster sensors at 512 columns); a point's
     /// column is its beam azimuth's fractional column less this offset, rounded.
     pub column_offsets: Vec<f32>,
+    /// The sensor's minimum range, metres (0: not known). The sensor reports nothing nearer, so a
+    /// point nearer than this is not a measurement: ordering reads it as a no-return
+    /// ([`super::OrderingReport::too_near`]), as it reads the `0, 0, 0` of a driver. nuScenes
+    /// writes its no-returns as `0, 0, 0` moved by the ego-motion compensation to where the sensor
+    /// was when it fired: up to a few decimetres from the origin, not at it.
+    pub min_range_m: f32,
 }
 
 impl BeamTable {
@@ -69,6 +75,7 @@ impl BeamTable {
             vertical_offsets_m: Vec::new(),
             along_offsets_m: Vec::new(),
             column_offsets: Vec::new(),
+            min_range_m: 0.0,
         }
     }
 
@@ -136,7 +143,14 @@ impl BeamTable {
             vertical_offsets_m: if any(&v) { v } else { Vec::new() },
             along_offsets_m: if any(&along) { along } else { Vec::new() },
             column_offsets: if any(&column_offsets) { column_offsets } else { Vec::new() },
+            min_range_m: 0.0,
         })
+    }
+
+    /// The table of a simulated sensor ([`BeamTable::from_pattern`] of its pattern) with its
+    /// minimum range.
+    pub fn from_spec(spec: &sim::sensor::SensorSpec) -> Result<Self> {
+        Ok(Self { min_range_m: spec.measurement().min_range_m, ..Self::from_pattern(&spec.pattern())? })
     }
 
     /// Checks the table and returns its rows sorted up.

@@ -24,7 +24,8 @@
 //! ([`placement`]): the adjacent free column on the point's side, else a further plane of the same
 //! cell. Points with NaN or infinite coordinates are skipped (decision 0) and counted; more than
 //! [`MAX_BAD_FRACTION`] of them refuses the cloud. Points at exactly (0, 0, 0) are no-returns
-//! (skipped, counted). [`OrderingReport`] gives the cell of every input point and what each step
+//! (skipped, counted), and so are points nearer than the sensor's minimum range where the table
+//! knows it ([`BeamTable::min_range_m`]). [`OrderingReport`] gives the cell of every input point and what each step
 //! placed.
 
 pub mod beam_table;
@@ -136,7 +137,7 @@ pub fn order_cloud_into<P: InputPoint>(
     let (usable, mut polar) = if attributes.rings.is_none() && choice != PathChoice::BeamTable {
         Usable::check_count(n)?;
         let (polar, counts) = polar::polar_counting(points_in_sensor, None);
-        let usable = Usable::from_counts(points_in_sensor, counts, report)?;
+        let usable = Usable::from_counts(points_in_sensor, counts, table.min_range_m, report)?;
         // With unusable points, the polar values of the usable ones only (rare).
         let polar = match usable.indices() {
             None => polar,
@@ -144,7 +145,7 @@ pub fn order_cloud_into<P: InputPoint>(
         };
         (usable, Some(polar))
     } else {
-        (Usable::find(points_in_sensor, report)?, None)
+        (Usable::find(points_in_sensor, table.min_range_m, report)?, None)
     };
     let place = |wishes: Vec<placement::Wish>, report: &mut OrderingReport| {
         placement::place(&wishes, rows.len(), rows.cols, rows.full_turn, report)

@@ -60,8 +60,15 @@ pub struct OrderingReport {
     pub outside: usize,
     /// Bad points skipped (NaN or infinite coordinates, a ring value out of range): decision 0.
     pub skipped: usize,
-    /// No-return points (0, 0, 0) skipped: decision 0.
+    /// No-return points skipped: decision 0. At (0, 0, 0), or nearer than the sensor's minimum
+    /// range ([`OrderingReport::too_near`]).
     pub no_returns: usize,
+    /// Of the no-returns, points nearer than the sensor's minimum range
+    /// ([`super::BeamTable::min_range_m`], kept in [`OrderingReport::min_range_m`]) but not at
+    /// (0, 0, 0): the sensor reports nothing there (nuScenes' motion-compensated no-returns).
+    pub too_near: usize,
+    /// The minimum range the points were read with, metres (0: none known).
+    pub min_range_m: f32,
     /// The sensor recovered from the data, where none was given (no rig, no calibration file):
     /// named when its table matched a known one ([`super::recover`]).
     pub sensor: Option<RecoveredSensor>,
@@ -92,6 +99,12 @@ impl OrderingReport {
             self.skipped,
             self.no_returns
         );
+        if self.too_near > 0 {
+            s.push_str(&format!(
+                " ({} of them nearer than the sensor's minimum range of {} m, not at 0, 0, 0)",
+                self.too_near, self.min_range_m
+            ));
+        }
         if self.rings_found > 0 {
             let what = if self.path == OrderingPath::Unfolded { "rings unfolded" } else { "rings with points" };
             s.push_str(&format!(", {} {what}", self.rings_found));

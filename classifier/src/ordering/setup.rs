@@ -12,8 +12,8 @@ use glam::{Affine3A, Vec3};
 use sim::SemanticClass;
 
 use super::{
-    BeamTable, Calibration, CloudBuffer, InputPoint, OrderingReport, PathChoice, PointAttributes, UnfoldParams,
-    order_cloud_into,
+    BeamTable, Calibration, CloudBuffer, InputPoint, OrderingReport, PathChoice, PointAttributes, RecoveredOrder,
+    UnfoldParams, order_cloud_into,
 };
 use crate::error::{ClassifyError, Result};
 
@@ -25,6 +25,17 @@ pub const KITTI_COLUMNS: usize = 2170;
 /// Beam counts an organized KITTI-layout frame is looked for with when no sensor is given, most
 /// first (an image read with too many rows repeats its elevations and is not taken).
 const ORGANIZED_BEAMS_UNGIVEN: [usize; 4] = [128, 64, 32, 16];
+
+/// Nearest points whose elevations the organized-layout test reads, metres: nearer, a beam's
+/// origin off the spin axis and a motion-compensated cloud's shift (nuScenes: up to half a metre
+/// per sweep) move a point's elevation by degrees, and nearer still lie the no-returns that
+/// compensation moved off 0, 0, 0.
+const ORGANIZED_MIN_RANGE_M: f32 = 1.0;
+
+/// Columns of a candidate organized layout whose points the test reads (every k-th column, over
+/// the whole image): 256 points per row are plenty for a row's mean and spread, and a flat cloud
+/// mixes its rows all over the file.
+const ORGANIZED_SAMPLED_COLUMNS: usize = 256;
 
 /// Largest mean spread of the elevations within the rows of a candidate organized layout, degrees:
 /// an organized image's row is one beam (spread about 0.1 deg with the beams' own azimuth offsets
@@ -86,7 +97,7 @@ impl SensorSetup {
                 let s = &rig.sensors[0];
                 // KITTI files and the drivers' clouds of a single-sensor rig hold sensor-frame points.
                 Self {
-                    table: BeamTable::from_pattern(&s.spec.pattern())?,
+                    table: BeamTable::from_spec(&s.spec)?,
                     vehicle_from_sensor: s.mount.vehicle_from_sensor(),
                     calibrated_lasers: None,
                     recover: false,
@@ -99,7 +110,8 @@ impl SensorSetup {
             let cal = Calibration::load(file, expected).map_err(|e| ClassifyError::Ordering(e.to_string()))?;
             let cols = cal.columns.unwrap_or(if rig.is_some() { setup.table.cols } else { KITTI_COLUMNS });
             setup.calibrated_lasers = Some(cal.lasers.len());
-            setup.table = cal.to_table(cols);
+            // The calibration gives the lasers; a rig given beside it, the sensor's minimum range.
+            setup.table = BeamTable { min_range_m: setup.table.min_range_m, ..cal.to_table(cols) };
             setup.recover = false;
         }
         Ok(setup)
@@ -154,7 +166,7 @@ impl SensorSetup {
         let beams = self.table.elevations_rad.len();
         // Without a sensor given, an image of any of the usual beam counts.
         let layout = if self.recover {
-            ORGANIZED_BEAMS_UNGIVEN.iter().find_map(|&b| OrganizedLayout::detect(records, b))
+            OrganizedLayout::detect_first(records, &ORGANIZED_BEAMS_UNGIVEN)
         } else {
             OrganizedLayout::detect(records, beams)
         };
@@ -174,7 +186,12 @@ impl SensorSetup {
         if self.recover {
             // The image's rows are the rings; the table is the one they show.
             let attributes = PointAttributes { labels, rings: Some(&rings), ..PointAttributes::default() };
-            return self.order_flat(records, &attributes, cloud, report);
+            self.order_flat(records, &attributes, cloud, report)?;
+            if let Some(sensor) = report.sensor.as_mut() {
+                sensor.order =
+                    if layout.column_major { RecoveredOrder::ImageColumns } else { RecoveredOrder::ImageRows };
+            }
+            return Ok(());
         }
         // A spinning sensor's image: its own column count over the turn (the table's beams, offsets
         // kept); another table is used as it is.
@@ -188,6 +205,7 @@ impl SensorSetup {
             azimuth_offsets_rad: self.table.azimuth_offsets_rad.clone(),
             horizontal_offsets_m: self.table.horizontal_offsets_m.clone(),
             vertical_offsets_m: self.table.vertical_offsets_m.clone(),
+            min_range_m: self.table.min_range_m,
             ..table
         };
         let attributes = PointAttributes { labels, rings: Some(&rings), ..PointAttributes::default() };
@@ -229,9 +247,11 @@ impl OrganizedLayout {
     }
 
     /// Tells whether `records` are a whole `beams`-row sensor image: their count a multiple of
-    /// `beams` (at least 16 columns), some `0, 0, 0` no-returns among them (a KITTI `.bin` has
-    /// none), and, row by row or column by column, every row holding one beam (the mean spread of
-    /// its points' elevations under [`ORGANIZED_ROW_SPREAD_DEG`], the other reading's well above).
+    /// `beams` (at least 16 columns) and, row by row or column by column, every row holding one
+    /// beam (the mean spread of its points' elevations beyond [`ORGANIZED_MIN_RANGE_M`] under
+    /// [`ORGANIZED_ROW_SPREAD_DEG`], the other reading's well above). Row by row only with some
+    /// `0, 0, 0` no-returns among them (a KITTI `.bin` has none); column by column, whole firings
+    /// are an image with or without them.
     /// `None` for any other cloud.
     ///
     /// ```
@@ -250,30 +270,51 @@ impl OrganizedLayout {
     /// assert!(layout.column_major && layout.rows == 4 && layout.cols == 32);
     /// ```
     pub fn detect(records: &[[f32; 4]], beams: usize) -> Option<Self> {
+        Self::detect_first(records, &[beams])
+    }
+
+    /// [`OrganizedLayout::detect`] for each of `beams` in turn: the first layout found.
+    pub fn detect_first(records: &[[f32; 4]], beams: &[usize]) -> Option<Self> {
         let n = records.len();
-        if beams < 2 || !n.is_multiple_of(beams) || n / beams < 16 {
-            return None;
-        }
-        if !records.iter().any(|p| p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0) {
-            return None;
-        }
-        let cols = n / beams;
+        let mut candidates = beams.iter().copied().filter(|&b| b >= 2 && n.is_multiple_of(b) && n / b >= 16).peekable();
+        candidates.peek()?;
+        // A flat cloud in ring-major order (KITTI) whose count happens to be a multiple of `beams`
+        // reads row by row as rows of about one ring each: only a cloud with no-returns in it is
+        // taken for a row-by-row image. Column by column, a flat cloud's rows mix its lasers as
+        // soon as one point is missing, so a cloud of whole firings is an image as it stands
+        // (nuScenes, whose no-returns the ego-motion compensation moved off 0, 0, 0).
+        let has_zeros = records.iter().any(|p| p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0);
+        candidates.find_map(|b| Self::detect_beams(records, b, has_zeros))
+    }
+
+    /// The record of image cell (`row`, `col`) (file rows).
+    fn record_of_cell(&self, row: usize, col: usize) -> usize {
+        if self.column_major { col * self.rows + row } else { row * self.cols + col }
+    }
+
+    /// The layout of `beams` rows that `records` show, if any, read on up to
+    /// [`ORGANIZED_SAMPLED_COLUMNS`] columns spread over the image.
+    fn detect_beams(records: &[[f32; 4]], beams: usize, has_zeros: bool) -> Option<Self> {
+        let cols = records.len() / beams;
+        let stride = cols.div_ceil(ORGANIZED_SAMPLED_COLUMNS).max(1);
         let row_major = Self { rows: beams, cols, column_major: false };
         let column_major = Self { rows: beams, cols, column_major: true };
         // Per row of a reading: the mean and the spread of its points' elevations, degrees.
         let rows_of = |layout: &Self| -> Vec<(f64, f64)> {
             let mut sum = vec![(0.0f64, 0.0f64, 0u32); beams];
-            for (k, p) in records.iter().enumerate() {
-                let v = Vec3::new(p[0], p[1], p[2]);
-                let d = v.length();
-                if !(d > 0.1 && d.is_finite()) {
-                    continue;
+            for (row, s) in sum.iter_mut().enumerate() {
+                for col in (0..cols).step_by(stride) {
+                    let p = records[layout.record_of_cell(row, col)];
+                    let v = Vec3::new(p[0], p[1], p[2]);
+                    let d = v.length();
+                    if !(d > ORGANIZED_MIN_RANGE_M && d.is_finite()) {
+                        continue;
+                    }
+                    let el = f64::from((v.z / d).clamp(-1.0, 1.0).asin().to_degrees());
+                    s.0 += el;
+                    s.1 += el * el;
+                    s.2 += 1;
                 }
-                let el = f64::from((v.z / d).clamp(-1.0, 1.0).asin().to_degrees());
-                let s = &mut sum[layout.cell_of_record(k) / cols];
-                s.0 += el;
-                s.1 += el * el;
-                s.2 += 1;
             }
             sum.iter()
                 .filter(|s| s.2 >= 2)
@@ -300,7 +341,8 @@ impl OrganizedLayout {
             (rows.iter().map(|r| r.1).sum::<f64>() / rows.len() as f64) as f32
         };
         let (a, b) = (spread(&row_major), spread(&column_major));
-        let (best, spread_best, spread_other) = if a <= b { (row_major, a, b) } else { (column_major, b, a) };
+        let (best, spread_best, spread_other) =
+            if has_zeros && a <= b { (row_major, a, b) } else { (column_major, b, a) };
         (spread_best < ORGANIZED_ROW_SPREAD_DEG && spread_other > 2.0 * ORGANIZED_ROW_SPREAD_DEG).then_some(best)
     }
 }
@@ -343,6 +385,15 @@ mod tests {
         // Without no-returns (a KITTI frame) nothing is organized.
         let full: Vec<[f32; 4]> = image(16, 256, false).into_iter().filter(|p| p[0] != 0.0).collect();
         assert_eq!(OrganizedLayout::detect(&full, 16), None);
+        // No-returns moved off 0, 0, 0 (nuScenes' ego-motion compensation): whole firings stored
+        // one after another are an image; row by row, only a cloud with no-returns at 0, 0, 0 is.
+        let moved = |column_major: bool| -> Vec<[f32; 4]> {
+            let off_origin = |p: [f32; 4]| if p[0] == 0.0 { [0.001, -0.3, -0.003, 0.5] } else { p };
+            image(16, 256, column_major).into_iter().map(off_origin).collect()
+        };
+        let firings = OrganizedLayout::detect(&moved(true), 16);
+        assert_eq!(firings, Some(OrganizedLayout { rows: 16, cols: 256, column_major: true }));
+        assert_eq!(OrganizedLayout::detect(&moved(false), 16), None);
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! The usable points of a cloud: those with finite coordinates that are not the (0, 0, 0) a
-//! driver writes for a no-return. Bad points (NaN, infinite) are counted and skipped, and more
-//! than [`MAX_BAD_FRACTION`] of them refuse the cloud; no-returns are counted and skipped.
+//! driver writes for a no-return, nor nearer than the sensor's minimum range where it is known
+//! (a motion-compensated no-return: [`super::BeamTable::min_range_m`]). Bad points (NaN,
+//! infinite) are counted and skipped, and more than [`MAX_BAD_FRACTION`] of them refuse the cloud;
+//! no-returns are counted and skipped.
 //!
 //! Real files rarely hold either, so the common case keeps no index list at all: usable point `i`
 //! is input point `i` ([`Usable::point`]), and the passes over the points read them contiguously.
@@ -19,11 +21,12 @@ pub(crate) struct Usable {
 }
 
 impl Usable {
-    /// Finds the usable points of `points`, counting bad points and no-returns in `report`.
-    pub(crate) fn find<P: InputPoint>(points: &[P], report: &mut OrderingReport) -> Result<Self> {
+    /// Finds the usable points of `points`, counting bad points and no-returns (points nearer
+    /// than `min_range_m` among them; 0: none) in `report`.
+    pub(crate) fn find<P: InputPoint>(points: &[P], min_range_m: f32, report: &mut OrderingReport) -> Result<Self> {
         Self::check_count(points.len())?;
         // A counting pass without branches (it vectorizes); the index list only where needed.
-        Self::from_counts(points, count_bad_and_zero(points), report)
+        Self::from_counts(points, count_bad_and_zero(points), min_range_m, report)
     }
 
     /// Refuses clouds of more points than the cells' `u32` indices can hold.
@@ -39,10 +42,21 @@ impl Usable {
     pub(crate) fn from_counts<P: InputPoint>(
         points: &[P],
         (bad, zero): (usize, usize),
+        min_range_m: f32,
         report: &mut OrderingReport,
     ) -> Result<Self> {
+        // Nearer than the minimum range, not at (0, 0, 0) (counted above): one more pass, only
+        // where the sensor's minimum range is known.
+        let near_sq = min_range_m * min_range_m;
+        let too_near = |p: glam::Vec3| {
+            let d = p.length_squared();
+            (d < near_sq) & (d > 0.0)
+        };
+        let near = if min_range_m > 0.0 { points.iter().filter(|p| too_near(p.xyz())).count() } else { 0 };
         report.skipped += bad;
-        report.no_returns += zero;
+        report.no_returns += zero + near;
+        report.too_near += near;
+        report.min_range_m = min_range_m;
         if report.skipped as f64 > MAX_BAD_FRACTION * points.len() as f64 {
             return Err(ClassifyError::Ordering(format!(
                 "{} of {} points have NaN or infinite coordinates (at most {} % may)",
@@ -51,13 +65,13 @@ impl Usable {
                 MAX_BAD_FRACTION * 100.0
             )));
         }
-        if bad + zero == 0 {
+        if bad + zero + near == 0 {
             return Ok(Self { idx: None, len: points.len() });
         }
         let idx: Vec<u32> = (0..points.len() as u32)
             .filter(|&k| {
                 let p = points[k as usize].xyz();
-                bad_and_no_return(p.x, p.y, p.z) == (false, false)
+                bad_and_no_return(p.x, p.y, p.z) == (false, false) && !too_near(p)
             })
             .collect();
         Ok(Self { len: idx.len(), idx: Some(idx) })
@@ -158,18 +172,26 @@ mod tests {
         pts[7] = Vec3::new(f32::NAN, 0.0, 0.0);
         pts[9] = Vec3::new(0.0, f32::INFINITY, 0.0);
         let mut report = OrderingReport::default();
-        let u = Usable::find(&pts, &mut report).unwrap();
+        let u = Usable::find(&pts, 0.0, &mut report).unwrap();
         assert_eq!((report.skipped, report.no_returns, u.len()), (2, 1, 297));
         assert_eq!((u.point(4), u.point(5), u.point(6), u.point(7)), (4, 6, 8, 10));
         assert_eq!(u.iter().count(), 297);
         let mut report = OrderingReport::default();
-        let all = Usable::find(&pts[10..], &mut report).unwrap();
+        let all = Usable::find(&pts[10..], 0.0, &mut report).unwrap();
         assert!(all.indices().is_none());
         assert_eq!((all.len(), all.point(17), report.skipped + report.no_returns), (290, 17, 0));
+        // With a minimum range of 3.8 m (the points lie 3.74 m out): every usable point is too
+        // near; at 3.7 m none is. The one at 0, 0, 0 is a no-return either way, not too near.
+        let mut report = OrderingReport::default();
+        let none = Usable::find(&pts, 3.8, &mut report).unwrap();
+        assert_eq!((none.len(), report.no_returns, report.too_near, report.skipped), (0, 298, 297, 2));
+        let mut report = OrderingReport::default();
+        let u = Usable::find(&pts, 3.7, &mut report).unwrap();
+        assert_eq!((u.len(), report.no_returns, report.too_near, report.min_range_m), (297, 1, 0, 3.7));
         // More than 1 % bad: refused.
         pts[11] = Vec3::NAN;
         pts[12] = Vec3::NAN;
         let mut report = OrderingReport::default();
-        assert!(Usable::find(&pts[..100], &mut report).is_err());
+        assert!(Usable::find(&pts[..100], 0.0, &mut report).is_err());
     }
 }

@@ -19,6 +19,8 @@ pub(crate) struct KnownSensor {
     pub rows: TableRows,
     /// The settings of each rotation rate or lidar mode, with the columns they give.
     pub options: Vec<(usize, SensorSpec)>,
+    /// The default settings' minimum range, metres ([`BeamTable::min_range_m`]).
+    pub min_range_m: f32,
 }
 
 /// The spinning models of `sim::sensor::MODELS` (all but the Ibeo, the Hokuyos and `custom`).
@@ -37,7 +39,7 @@ fn known(model: &'static str) -> Option<KnownSensor> {
     let pattern = spec.pattern();
     let rows = BeamTable::from_pattern(&pattern).ok()?.rows().ok()?;
     let options = column_options(&spec);
-    Some(KnownSensor { model, rows, options })
+    Some(KnownSensor { model, rows, options, min_range_m: spec.measurement().min_range_m })
 }
 
 /// The settings of every rotation rate (and Ouster lidar mode) of `spec`'s model that validates,
@@ -150,7 +152,7 @@ impl KnownSensor {
             return Some(t.clone());
         }
         let spec = &self.options.iter().find(|o| o.0 == columns)?.1;
-        let table = BeamTable::from_pattern(&spec.pattern()).ok()?;
+        let table = BeamTable::from_spec(spec).ok()?;
         tables.lock().ok()?.insert((self.model, columns), table.clone());
         Some(table)
     }

@@ -71,6 +71,12 @@ pub enum RecoveredOrder {
     Firing,
     /// Any order: each point's laser from the cloud's ring field ([`ring_field`]).
     RingField,
+    /// A headerless file holding a whole sensor image, row by row (a row is one laser:
+    /// ouster-ros): each point's laser from its row ([`super::OrganizedLayout`]).
+    ImageRows,
+    /// A headerless file holding a whole sensor image column by column (a column is one firing:
+    /// RELLIS-3D, nuScenes): each point's laser from its place in the firing.
+    ImageColumns,
 }
 
 impl RecoveredOrder {
@@ -80,6 +86,8 @@ impl RecoveredOrder {
             RecoveredOrder::RingMajor => "ring-major",
             RecoveredOrder::Firing => "firing",
             RecoveredOrder::RingField => "ring-field",
+            RecoveredOrder::ImageRows => "image-rows",
+            RecoveredOrder::ImageColumns => "image-columns",
         }
     }
 }
@@ -109,6 +117,8 @@ impl RecoveredSensor {
     pub fn summary(&self) -> String {
         let order = match self.order {
             RecoveredOrder::RingField => "lasers from the ring field".to_string(),
+            RecoveredOrder::ImageRows => "lasers from the rows of a whole image stored row by row".to_string(),
+            RecoveredOrder::ImageColumns => "lasers from the rows of a whole image stored firing by firing".to_string(),
             o => format!("{} order", o.name()),
         };
         let how = format!(
@@ -229,7 +239,8 @@ fn named_table(sensor: &known::KnownSensor, cols_estimate: usize) -> (BeamTable,
         .columns_near(cols_estimate as f64)
         .filter(|&c| (c as f64 - cols_estimate as f64).abs() <= EXACT_COLUMNS * cols_estimate as f64);
     if sensor.model == "hdl64e" && exact.is_none() {
-        return (BeamTable::hdl64e(super::KITTI_COLUMNS), super::KITTI_COLUMNS);
+        let t = BeamTable { min_range_m: sensor.min_range_m, ..BeamTable::hdl64e(super::KITTI_COLUMNS) };
+        return (t, super::KITTI_COLUMNS);
     }
     if let Some(cols) = sensor.columns_near(cols_estimate as f64)
         && let Some(t) = sensor.table(cols)
@@ -243,6 +254,7 @@ fn named_table(sensor: &known::KnownSensor, cols_estimate: usize) -> (BeamTable,
     (t.cols, t.azimuth_step_rad, t.azimuth_left_rad) = (cols_estimate, step, PI - 0.5 * step);
     // Its lasers' column offsets are in the listed rate's columns: left out.
     t.column_offsets.clear();
+    t.min_range_m = sensor.min_range_m;
     (t, cols_estimate)
 }
 

@@ -86,12 +86,17 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     lasers.sort_by(|a, b| a.1.total_cmp(&b.1));
     let tan_sorted: Vec<f32> = lasers.iter().map(|l| l.1).collect();
     let dist_sorted: Vec<f32> = lasers.iter().map(|l| l.2).collect();
-    // Columns: the median azimuth gap within the four fullest rings, their azimuths sorted.
+    let matched = matching::match_rings(&tan_sorted, &dist_sorted);
+    // Columns: the median azimuth gap within the four fullest rings, their azimuths sorted, over
+    // the points at or beyond a matched sensor's minimum range (nearer ones are no-returns:
+    // nuScenes' motion-compensated ones pile up at one azimuth and would shorten the median gap).
+    let min_range_m = matched.as_ref().map_or(0.0, |m| m.sensor.min_range_m);
     let mut fullest = present.clone();
     fullest.sort_by_key(|&g| std::cmp::Reverse(span(g).len()));
     let mut gaps = Vec::new();
     for &g in fullest.iter().take(4) {
-        let mut a = az[span(g)].to_vec();
+        let mut a: Vec<f32> =
+            span(g).filter(|&i| dist[i] * (1.0 + tan[i] * tan[i]).sqrt() >= min_range_m).map(|i| az[i]).collect();
         a.sort_by(f32::total_cmp);
         gaps.extend(a.windows(2).map(|w| w[1] - w[0]).filter(|&s| s > 1e-4));
     }
@@ -102,7 +107,6 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     } else {
         largest.max(2)
     };
-    let matched = matching::match_rings(&tan_sorted, &dist_sorted);
     let (table, columns, row_of_sorted) = match &matched {
         Some(m) => {
             let (table, columns) = named_table(m.sensor, cols_estimate);
