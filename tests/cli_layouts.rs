@@ -10,7 +10,7 @@
 //!   dense but holds NaNs is read the same way, with a warning;
 //! - `eval dataset` on a nuScenes-lidarseg folder (`lidar/*.pcd.bin`, `lidarseg/*_lidarseg.bin`).
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! Every bundled scene: loads, validates, is deterministic, has ground and non-ground, is big
 //! enough, and the ego origin stands on ground.
 
-mod common;
+use crate::common;
 
 /// Families whose geometry does not depend on the seed.
 const SEED_FREE: [&str; 2] = ["ramp-up", "ramp-down"];

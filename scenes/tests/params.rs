@@ -1,6 +1,6 @@
 //! The generators honour their parameters, measured on the mesh.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use sim::SemanticClass;

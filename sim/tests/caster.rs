@@ -2,7 +2,7 @@
 //! watertightness on grid edges and vertices, analytic plane distances, and thread-count
 //! independence of `cast_all`.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use rand::{RngExt, SeedableRng};

@@ -5,7 +5,7 @@
 //! message, unless `GROUNDTRUTH_REQUIRE_GPU=1` (CI, on Mesa's lavapipe) makes that a failure.
 #![cfg(feature = "gpu")]
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use rand::{RngExt, SeedableRng};
@@ -200,11 +200,14 @@ fn gpu_caster_new_reads_the_layout_from_the_environment() {
         return;
     }
     let exe = std::env::current_exe().expect("the test binary");
+    // The test's name in the harness: its module path less the test binary's crate name.
+    let test = "gpu_caster_new_reads_the_layout_from_the_environment";
+    let name = module_path!().split_once("::").map_or(test.to_string(), |(_, m)| format!("{m}::{test}"));
     for (value, expect) in
         [("bvh2", "bvh2"), ("cwbvh", "cwbvh"), ("", &*GpuBvh::default().to_string()), ("octree", "refused")]
     {
         let out = std::process::Command::new(&exe)
-            .args(["--exact", "gpu_caster_new_reads_the_layout_from_the_environment", "--test-threads=1"])
+            .args(["--exact", &name, "--test-threads=1"])
             .env(GpuBvh::ENV, value)
             .env(CHILD, expect)
             .output()

@@ -4,7 +4,7 @@
 //! instead of a panic or a silent fallback to the CPU.
 #![cfg(feature = "gpu")]
 
-mod common;
+use crate::common;
 
 use common::gpu_caster;
 use sim::cast::gpu::GpuOptions;

@@ -155,7 +155,7 @@ fn every_roof_sensor_read_from_a_ring_field_without_a_rig_gets_its_own_table() {
 /// The target of the way in without a rig: each roof sensor's `rural` frame (seed 31337) written as
 /// a ring-less KITTI `.bin` and classified by `learned` without a rig (the sensor recovered) and
 /// with its rig: F1 within 0.005. Prints the figures and the ordering's milliseconds per thousand
-/// points (`cargo test -p gt-tests --test rings_recovered -- --ignored --nocapture`).
+/// points (`cargo test --workspace --test integration rings_recovered:: -- --ignored --nocapture`).
 #[test]
 #[ignore = "a measurement: several sensors' scans classified twice"]
 fn learned_f1_without_a_rig_is_the_f1_with_it() {
