@@ -109,6 +109,44 @@ fn a_small_model_trains_deterministically_and_beats_nitsch_on_unseen_seeds() {
     assert!(e.contains("train.toml") && e.contains("invalid model JSON"), "{e}");
 }
 
+/// `train --config` takes every scene a dataset file takes: here a generator family with its
+/// parameters (a steep ramp down), which it used to refuse as an empty scene name.
+#[test]
+fn training_takes_a_family_with_its_parameters() {
+    let dir = tmp("family");
+    let config = dir.join("train.toml");
+    std::fs::write(
+        &config,
+        r#"
+name = "ci-family"
+[[sequences]]
+id = 0
+family = "ramp"
+params = { slope_deg = -17.0, distance_m = 5.0 }
+seed = 3
+rig = "vlp16-roof"
+frames = 1
+[[sequences]]
+id = 1
+scene = "city"
+seed = 4
+rig = "vlp16-roof"
+frames = 1
+[train]
+method = "learned"
+trees = 2
+samples_per_frame = 2000
+validation_every = 2
+"#,
+    )
+    .unwrap();
+    let model = dir.join("m.json");
+    let out = ok(run(&["train", "--method", "learned", "--config", s(&config), "--out", s(&model)]));
+    assert!(out.contains("2 sequences, 2 frames") && out.contains("trained 2 trees"), "{out}");
+    let scenes = &json(&model)["trained_on"]["scenes"];
+    assert_eq!(scenes, &serde_json::json!(["city", "ramp"]), "{scenes}");
+}
+
 #[test]
 fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
     let dir = tmp("eval");

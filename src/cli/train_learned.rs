@@ -137,7 +137,8 @@ fn from_config(path: &Path, params: &TrainParams) -> anyhow::Result<(TrainingSet
         .enumerate()
         .map(|(sequence, (p, &first))| {
             let s = &p.config;
-            let scene = super::common::load_scene_full(&s.scene, s.seed)?;
+            // Any scene a dataset file takes: a bundled scene, a file or a family with its params.
+            let scene = s.spec.load_scene().with_context(|| format!("`sequences[{sequence}].scene`"))?;
             let scanner = sim::scan::Scanner::new(&scene.mesh, &p.rig, p.scan.clone())?;
             let setup = in_frame_of(SensorSetup::new(Some(&p.rig), None)?, sequence);
             let sensor_from_vehicle = p.rig.sensors[0].mount.vehicle_from_sensor().inverse();
@@ -164,7 +165,11 @@ fn from_config(path: &Path, params: &TrainParams) -> anyhow::Result<(TrainingSet
         "config": path.display().to_string(),
         "sequences": config.sequences.len(),
         "frames": total,
-        "scenes": config.sequences.iter().map(|s| s.scene.clone()).collect::<std::collections::BTreeSet<_>>(),
+        "scenes": config
+            .sequences
+            .iter()
+            .map(|s| s.spec.family.clone().unwrap_or_else(|| s.scene.clone()))
+            .collect::<std::collections::BTreeSet<_>>(),
         "rigs": config.sequences.iter().map(|s| s.rig.clone()).collect::<std::collections::BTreeSet<_>>(),
     });
     Ok((set, trained_on))
