@@ -50,6 +50,13 @@ pub struct RowKey {
 }
 
 impl RowKey {
+    /// The row's own stream for `purpose` (distinct from every beam's: column `u32::MAX` never
+    /// occurs in a grid).
+    pub fn rng(&self, purpose: Purpose) -> Xoshiro256PlusPlus {
+        BeamKey { seed: self.seed, frame: self.frame, sensor: self.sensor, ring: self.ring, column: u32::MAX }
+            .rng(purpose)
+    }
+
     /// `columns` standard normal draws of this row for `purpose`, one per column.
     pub fn normals(&self, purpose: Purpose, columns: usize) -> Vec<f32> {
         // Column u32::MAX never occurs in a grid, so row streams never collide with beam streams.

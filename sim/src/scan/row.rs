@@ -137,6 +137,11 @@ impl Scanner<'_> {
             }
             _ => Vec::new(),
         };
+        // Rain and snow: the row's candidate beams for a particle (the others draw nothing).
+        let mut candidates = Vec::new();
+        if let Some(w) = &self.weather[s] {
+            w.row_candidates(&row_key, pattern.cols, &mut candidates);
+        }
         for (mc, &c) in self.sensor_col_of[s].iter().enumerate() {
             view.ring[mc] = ring as u16;
             if c == NO_COLUMN {
@@ -238,7 +243,9 @@ impl Scanner<'_> {
                         ring: ring as u32,
                         column: c as u32,
                     };
-                    let echoes = w.echoes(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key);
+                    let candidate = candidates.get(c).copied().unwrap_or(false);
+                    let echoes =
+                        w.echoes_in_row(first.as_ref().map(|cell| (cell.range_m, cell.intensity)), &key, candidate);
                     match echoes.first {
                         BeamOutcome::Target { intensity } => first.map(|cell| Cell { intensity, ..cell }),
                         BeamOutcome::Medium { range_m, intensity, class } => {

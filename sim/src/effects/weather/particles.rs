@@ -225,6 +225,8 @@ pub struct ParticleTable {
     survival: Vec<[f64; LEVELS + 1]>,
     /// The ladder's floors, `p_min 2^(level / 2)` for `level = 0 ..= LEVELS`.
     floors: [f64; LEVELS + 1],
+    /// [`ParticleTable::candidate_chance`].
+    candidate_chance: f64,
 }
 
 impl ParticleTable {
@@ -241,6 +243,7 @@ impl ParticleTable {
             by_reach: Vec::new(),
             survival: Vec::new(),
             floors: [0.0; LEVELS + 1],
+            candidate_chance: 0.0,
         };
         for (level, f) in t.floors.iter_mut().enumerate() {
             *f = t.p_min * 2f64.powf(level as f64 / 2.0);
@@ -255,7 +258,18 @@ impl ParticleTable {
             }
         }
         t.survival = t.by_reach.iter().map(|row| row.map(|m| (-m).exp())).collect();
+        t.candidate_chance = 1.0 - t.survival.iter().map(|s| s[0]).fold(1.0, f64::min);
         t
+    }
+
+    /// The chance that a beam reaching the maximum range holds a particle that beats the
+    /// sensor's threshold: no beam's chance is higher (a beam's floor is at least the threshold,
+    /// its reach at most the maximum range), so a row draws its candidate beams with this chance
+    /// and each candidate keeps its particle with its own chance over this one
+    /// ([`ParticleTable::strongest_candidate`]): thinning, exact, and the other beams of the row
+    /// draw nothing.
+    pub(super) fn candidate_chance(&self) -> f64 {
+        self.candidate_chance
     }
 
     /// Beam diameter at `r`, m.
@@ -320,6 +334,31 @@ impl ParticleTable {
     /// strongest of them is the return, if it beats `floor` itself (floors between ladder steps).
     /// Exact, and a beam draws one to a few particles however many are in it.
     pub(super) fn strongest(&self, reach_m: f32, floor: f32, key: &BeamKey) -> Option<(f32, f32, SemanticClass)> {
+        self.strongest_with(reach_m, floor, key, None)
+    }
+
+    /// [`ParticleTable::strongest`] for a beam its row drew as a candidate with chance
+    /// `candidate_chance` ([`ParticleTable::candidate_chance`]): the beam holds a particle with
+    /// chance `P / candidate_chance`, `P` its chance as a beam of its own, so that over the row's
+    /// draw and this one it holds one with chance `P`, and the particle is drawn as
+    /// [`ParticleTable::strongest`] draws it.
+    pub(super) fn strongest_candidate(
+        &self,
+        reach_m: f32,
+        floor: f32,
+        key: &BeamKey,
+        candidate_chance: f64,
+    ) -> Option<(f32, f32, SemanticClass)> {
+        self.strongest_with(reach_m, floor, key, Some(candidate_chance))
+    }
+
+    fn strongest_with(
+        &self,
+        reach_m: f32,
+        floor: f32,
+        key: &BeamKey,
+        candidate_chance: Option<f64>,
+    ) -> Option<(f32, f32, SemanticClass)> {
         let floor = f64::from(floor);
         let reach = (f64::from(reach_m).min(self.max_range_m) - self.min_range_m) / STEP_M;
         if reach <= 0.0 {
@@ -334,7 +373,19 @@ impl ParticleTable {
         let survival = |level: usize| s_a[level] + frac * (s_b[level] - s_a[level]);
         let mut rng = key.rng(Purpose::Weather);
         // One uniform: particles beat floor L iff u > P(none does) = S_L (S grows with L).
-        let u = rng.random::<f64>();
+        let v = rng.random::<f64>();
+        let u = match candidate_chance {
+            None => v,
+            // A candidate keeps its particle with chance (1 - S_base) / q; given that, u is
+            // uniform on (S_base, 1), as the one uniform above is given u > S_base.
+            Some(q) => {
+                let s_base = survival(base);
+                if v * q >= 1.0 - s_base {
+                    return None;
+                }
+                s_base + v * q
+            }
+        };
         if survival(base) >= u {
             return None;
         }
