@@ -59,10 +59,7 @@ impl RowKey {
 
     /// `columns` standard normal draws of this row for `purpose`, one per column.
     pub fn normals(&self, purpose: Purpose, columns: usize) -> Vec<f32> {
-        // Column u32::MAX never occurs in a grid, so row streams never collide with beam streams.
-        let mut rng =
-            BeamKey { seed: self.seed, frame: self.frame, sensor: self.sensor, ring: self.ring, column: u32::MAX }
-                .rng(purpose);
+        let mut rng = self.rng(purpose);
         (0..columns).map(|_| rng.sample(StandardNormal)).collect()
     }
 }
