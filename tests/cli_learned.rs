@@ -193,12 +193,27 @@ fn eval_dataset_writes_scores_pictures_and_refuses_bad_input() {
         p["tp"].as_u64().unwrap() + p["fn"].as_u64().unwrap()
     };
     assert!(ground(&r) < ground(&doc));
+    // Roads left out (as WADS's falling snow is, `--ignore 110`): fewer points scored, the ground
+    // among them the same as with roads counted as non-ground.
+    let left = dir.join("left.json");
+    let args = ["eval", "dataset", "--input", s(&data), "--methods", "nitsch", "--ground", "44,48,49,60,72"];
+    ok(run(&[&args[..], &["--ignore", "40", "--json", s(&left)]].concat()));
+    let l = json(&left);
+    assert_eq!(l["protocol"]["name"], "semantickitti+ground+ignore");
+    assert!(l["protocol"]["ignored"].as_array().unwrap().contains(&serde_json::json!(40)), "{}", l["protocol"]);
+    let scored = |d: &serde_json::Value| {
+        let p = &d["methods"]["nitsch"]["pooled"];
+        ["tp", "fp", "fn", "tn"].iter().map(|k| p[k].as_u64().unwrap()).sum::<u64>()
+    };
+    assert!(scored(&l) < scored(&doc));
 
     // Bad input: each refused with the flag or file named, and no JSON written.
     let written = dir.join("never.json");
     let cases: Vec<(Vec<String>, &str)> = vec![
         (vec!["--ground".into(), "40,41".into()], "41"),
         (vec!["--ground".into(), "road".into()], "--ground"),
+        (vec!["--ignore".into(), "72".into()], "--ignore"),
+        (vec!["--ignore".into(), "112".into()], "112"),
         (vec!["--protocol".into(), "kitti".into()], "--protocol"),
         (vec!["--methods".into(), "nope".into()], "unknown method"),
         (vec!["--sequences".into(), "05".into()], "--sequences"),

@@ -4,8 +4,11 @@
 given to Patchwork++), so that both are compared on the same frames and counts:
 
     python python/bench/eval_patchwork.py DATASET_DIR [--sensor-height 1.73] [--protocol patchworkpp]
+                                          [--ground 40,44,48,49,60,72,111] [--ignore 110]
 
-`--protocol patchworkpp` also leaves vegetation (70) out, as Patchwork++'s own evaluation does.
+`--protocol patchworkpp` also leaves vegetation (70) out, as Patchwork++'s own evaluation does;
+`--ground` and `--ignore` change the ground set and leave more classes out, as `groundtruth eval
+dataset`'s flags of the same names do (WADS's snowfall: `--ground 40,44,48,49,60,72,111 --ignore 110`).
 One estimator runs over each sequence's frames in order (as its ROS node would). Prints one JSON
 object: pooled precision, recall, F1 and counts, the frame mean of F1, the worst frame, and the
 milliseconds per frame.
@@ -58,8 +61,17 @@ def main():
     ap.add_argument("dataset")
     ap.add_argument("--sensor-height", type=float, default=1.73)
     ap.add_argument("--protocol", choices=["semantickitti", "patchworkpp"], default="semantickitti")
+    ap.add_argument("--ground", help="ground class ids replacing the protocol's, comma-separated")
+    ap.add_argument("--ignore", help="class ids left out beside the protocol's, comma-separated")
     args = ap.parse_args()
     ignored = [0, 1] + ([70] if args.protocol == "patchworkpp" else [])
+    ground = GROUND
+    if args.ground:
+        ground = np.array([int(x) for x in args.ground.split(",")], dtype=np.uint32)
+    if args.ignore:
+        ignored += [int(x) for x in args.ignore.split(",")]
+    if np.isin(ground, ignored).any():
+        sys.exit("--ground and --ignore share a class")
     tot = {"tp": 0, "fp": 0, "fn": 0, "tn": 0}
     frames, times = [], []
     for seq in sequences(args.dataset):
@@ -81,7 +93,7 @@ def main():
             pred = np.zeros(len(pts), bool)
             pred[idx[np.asarray(pw.getGroundIndices(), dtype=np.int64)]] = True
             scored = returns & ~np.isin(labels, ignored)
-            truth = np.isin(labels, GROUND)
+            truth = np.isin(labels, ground)
             c = {
                 "tp": int((truth & pred & scored).sum()),
                 "fp": int((~truth & pred & scored).sum()),
@@ -97,6 +109,8 @@ def main():
             {
                 "method": "patchwork++ (pypatchworkpp %s)" % importlib.metadata.version("pypatchworkpp"),
                 "protocol": args.protocol,
+                "ground": [int(g) for g in ground],
+                "ignored": sorted(set(ignored)),
                 "sensor_height_m": args.sensor_height,
                 "pooled": {
                     "precision": tot["tp"] / max(1, tot["tp"] + tot["fp"]),

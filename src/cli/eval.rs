@@ -124,9 +124,14 @@ struct DatasetModeArgs {
     /// The protocol (`semantickitti`, `patchworkpp`, `patchwork`).
     #[arg(long, default_value = "semantickitti")]
     protocol: String,
-    /// Ground class ids replacing the protocol's (comma-separated SemanticKITTI ids).
+    /// Ground class ids replacing the protocol's (comma-separated SemanticKITTI ids, or WADS's 110
+    /// and 111).
     #[arg(long)]
     ground: Option<String>,
+    /// Class ids left out of the scores beside the protocol's (comma-separated; e.g. 110, WADS's
+    /// falling snow).
+    #[arg(long)]
+    ignore: Option<String>,
     /// With `--protocol patchwork`: the sensor's height above the ground, metres.
     #[arg(long, default_value_t = 1.73)]
     sensor_height_m: f32,
@@ -247,6 +252,7 @@ impl LegacyArgs {
                 calibration: self.calibration,
                 protocol: self.protocol,
                 ground: self.ground,
+                ignore: None,
                 sensor_height_m: self.sensor_height,
                 topic: self.topic,
                 layout: None,
@@ -293,6 +299,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             calibration: a.calibration.as_deref(),
             protocol: &a.protocol,
             ground: a.ground.as_deref(),
+            ignore: a.ignore.as_deref(),
             sensor_height_m: a.sensor_height_m,
             max_frames: a.max_frames,
             json: a.report.json.as_deref(),

@@ -35,6 +35,8 @@ pub struct DatasetArgs<'a> {
     pub protocol: &'a str,
     /// Ground classes replacing the protocol's.
     pub ground: Option<&'a str>,
+    /// Classes left out beside the protocol's.
+    pub ignore: Option<&'a str>,
     /// Sensor height for the `patchwork` protocol, metres.
     pub sensor_height_m: f32,
     /// Frames per sequence at most.
@@ -54,11 +56,11 @@ pub struct DatasetArgs<'a> {
     pub layout: Option<classifier::recording::LayoutChoice>,
 }
 
-/// Parses `--ground 40,44,...`.
-fn parse_ground(text: &str) -> anyhow::Result<Vec<u32>> {
+/// Parses the class ids of `flag` (`--ground 40,44,...`, `--ignore 110`).
+fn parse_classes(flag: &str, text: &str) -> anyhow::Result<Vec<u32>> {
     super::common::split_list(text)
         .iter()
-        .map(|s| s.parse::<u32>().with_context(|| format!("--ground: `{s}` is not a class id (e.g. 40,44,48)")))
+        .map(|s| s.parse::<u32>().with_context(|| format!("{flag}: `{s}` is not a class id (e.g. 40,44,48)")))
         .collect()
 }
 
@@ -66,7 +68,10 @@ fn parse_ground(text: &str) -> anyhow::Result<Vec<u32>> {
 pub fn run(args: &DatasetArgs<'_>) -> anyhow::Result<()> {
     let mut protocol = Protocol::named(args.protocol, args.sensor_height_m)?;
     if let Some(g) = args.ground {
-        protocol = protocol.with_ground(&parse_ground(g)?)?;
+        protocol = protocol.with_ground(&parse_classes("--ground", g)?)?;
+    }
+    if let Some(i) = args.ignore {
+        protocol = protocol.with_ignored(&parse_classes("--ignore", i)?)?;
     }
     if args.methods.is_empty() {
         bail!("--methods is empty; known: {}", classifier::METHODS.join(", "));

@@ -65,7 +65,7 @@ pub enum DatasetError {
     },
     /// A class id that SemanticKITTI does not define, given as ground or ignored.
     #[error(
-        "{flag}: class id {id} is not a SemanticKITTI label id (known: 0, 1, 10, ..., 99, 252-259; see `groundtruth list`)"
+        "{flag}: class id {id} is not a SemanticKITTI label id (known: 0, 1, 10, ..., 99, 252-259; see `groundtruth list`) nor WADS's 110 (falling snow) or 111 (accumulated snow)"
     )]
     UnknownClass {
         /// The flag or field.

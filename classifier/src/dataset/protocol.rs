@@ -33,6 +33,18 @@ pub const IGNORED_CLASSES: [u16; 2] = [0, 1];
 /// SemanticKITTI's vegetation class.
 pub const VEGETATION: u16 = 70;
 
+/// Class ids of other public datasets in the SemanticKITTI layout that `--ground` and `--ignore`
+/// take beside SemanticKITTI's own: WADS's falling snow and the snow lying on the ground.
+pub const OTHER_DATASET_CLASSES: [(u16, &str); 2] = [(110, "active snowfall (WADS)"), (111, "accumulated snow (WADS)")];
+
+/// `id` as a class id `flag` takes: a SemanticKITTI label id or one of [`OTHER_DATASET_CLASSES`].
+fn class_id(flag: &'static str, id: u32) -> Result<u16, DatasetError> {
+    u16::try_from(id)
+        .ok()
+        .filter(|&c| sim::scene::semantic_kitti::is_known(c) || OTHER_DATASET_CLASSES.iter().any(|o| o.0 == c))
+        .ok_or(DatasetError::UnknownClass { flag, id })
+}
+
 /// The protocols by name.
 pub const PROTOCOLS: [&str; 3] = ["semantickitti", "patchworkpp", "patchwork"];
 
@@ -105,10 +117,7 @@ impl Protocol {
         }
         let mut set = BTreeSet::new();
         for &id in ground {
-            let known = u16::try_from(id).is_ok_and(sim::scene::semantic_kitti::is_known);
-            if !known {
-                return Err(DatasetError::UnknownClass { flag: "--ground", id });
-            }
+            class_id("--ground", id)?;
             if self.ignored.contains(&(id as u16)) {
                 return Err(DatasetError::Invalid {
                     flag: "--ground",
@@ -121,6 +130,36 @@ impl Protocol {
         if set != self.ground {
             self.name = format!("{}+ground", self.name);
             self.ground = set;
+        }
+        Ok(self)
+    }
+
+    /// The same protocol with more classes left out (`--ignore`; e.g. WADS's falling snow, 110, as
+    /// issue 45 scores real snowfall): each a SemanticKITTI label id or one of
+    /// [`OTHER_DATASET_CLASSES`], none of the ground classes.
+    ///
+    /// ```
+    /// use classifier::dataset::Protocol;
+    /// let p = Protocol::named("semantickitti", 1.73)?.with_ground(&[40, 44, 48, 49, 60, 72, 111])?.with_ignored(&[110])?;
+    /// assert_eq!(p.name, "semantickitti+ground+ignore");
+    /// assert_eq!((p.truth(110, -1.0), p.truth(111, -1.7)), (None, Some(true)));
+    /// # Ok::<(), classifier::dataset::DatasetError>(())
+    /// ```
+    pub fn with_ignored(mut self, ignored: &[u32]) -> Result<Self, DatasetError> {
+        let before = self.ignored.len();
+        for &id in ignored {
+            let class = class_id("--ignore", id)?;
+            if self.ground.contains(&class) {
+                return Err(DatasetError::Invalid {
+                    flag: "--ignore",
+                    value: id.to_string(),
+                    allowed: "a class that is not ground (change the ground set with --ground)".to_string(),
+                });
+            }
+            self.ignored.insert(class);
+        }
+        if self.ignored.len() != before {
+            self.name = format!("{}+ignore", self.name);
         }
         Ok(self)
     }
@@ -163,7 +202,18 @@ mod tests {
         assert!(e.contains("--ground") && e.contains("41"), "{e}");
         let e = d.clone().with_ground(&[40, 70_000]).unwrap_err().to_string();
         assert!(e.contains("70000"), "{e}");
-        let e = d.with_ground(&[40, 0]).unwrap_err().to_string();
+        let e = d.clone().with_ground(&[40, 0]).unwrap_err().to_string();
         assert!(e.contains("does not leave out"), "{e}");
+        // WADS: falling snow left out, snow on the ground counted as ground.
+        let w = d.clone().with_ground(&[40, 44, 48, 49, 60, 72, 111]).unwrap().with_ignored(&[110]).unwrap();
+        assert_eq!(w.name, "semantickitti+ground+ignore");
+        assert_eq!((w.truth(110, 0.0), w.truth(111, 0.0), w.truth(50, 0.0)), (None, Some(true), Some(false)));
+        assert_eq!(d.clone().with_ignored(&[0, 1]).unwrap().name, "semantickitti");
+        let e = d.clone().with_ignored(&[112]).unwrap_err().to_string();
+        assert!(e.contains("--ignore") && e.contains("112"), "{e}");
+        let e = d.clone().with_ignored(&[72]).unwrap_err().to_string();
+        assert!(e.contains("--ignore") && e.contains("not ground"), "{e}");
+        let e = d.with_ground(&[40, 110]).unwrap().with_ignored(&[110]).unwrap_err().to_string();
+        assert!(e.contains("110"), "{e}");
     }
 }
