@@ -245,6 +245,7 @@ def eval_dataset(
     calibration: Optional[_Path] = None,
     protocol: str = "semantickitti",
     ground: Optional[Sequence[int]] = None,
+    ignore: Optional[Sequence[int]] = None,
     sensor_height_m: float = 1.73,
     sequences: Optional[Sequence[str]] = None,
     max_frames: Optional[int] = None,
@@ -255,7 +256,9 @@ def eval_dataset(
     recording or a nuScenes-lidarseg folder (``lidar/*.pcd.bin``, ``lidarseg/*_lidarseg.bin``), as
     ``groundtruth eval --dataset`` does; the dict is its ``--json`` document:
     ``result["methods"]["learned"]["pooled"]["f1"]``, per frame under ``"frames"``. ``layout``
-    (``"kitti"``, ``"nuscenes"``) names the records of the ``.bin`` files."""
+    (``"kitti"``, ``"nuscenes"``) names the records of the ``.bin`` files; ``ground`` replaces the
+    protocol's ground class ids and ``ignore`` leaves more classes out (WADS's snowfall:
+    ``ground=[40, 44, 48, 49, 60, 72, 111], ignore=[110]``)."""
 
 def read(
     path: _Path,

@@ -30,14 +30,14 @@ fn dataset_error(e: DatasetError) -> PyErr {
 /// `groundtruth classify` reads a `.bin` (ordered with `rig`'s beam table and mount, or
 /// `calibration`'s; a dataset written by `groundtruth dataset` without either: each sequence's own
 /// rig), under `protocol` (`semantickitti`, `patchworkpp`, `patchwork`; `ground` replaces its ground
-/// class ids). Returns a dict `{"dataset", "protocol", "range_bands", "methods": {name: {"pooled":
+/// class ids, `ignore` leaves more classes out, e.g. `[110]`, WADS's falling snow). Returns a dict `{"dataset", "protocol", "range_bands", "methods": {name: {"pooled":
 /// {"precision", "recall", "f1", "iou", "accuracy", "tp", "fp", "tn", "fn", "points"},
 /// "frame_mean", "by_range", "worst_frame", "mean_classify_ms", "frames": [...]}}}`, the document of
 /// `groundtruth eval --dataset --json`. A folder of nuScenes sweeps with their lidarseg labels
 /// (`lidar/NAME.pcd.bin`, `lidarseg/NAME_lidarseg.bin`) is scored too; `layout` (`"kitti"`,
 /// `"nuscenes"`) names the records of the `.bin` files (default: by name and content).
 #[pyfunction]
-#[pyo3(signature = (path, methods=vec!["nitsch".to_string(), "learned".to_string()], *, rig=None, calibration=None, protocol="semantickitti", ground=None, sensor_height_m=1.73, sequences=None, max_frames=None, model=None, layout=None))]
+#[pyo3(signature = (path, methods=vec!["nitsch".to_string(), "learned".to_string()], *, rig=None, calibration=None, protocol="semantickitti", ground=None, ignore=None, sensor_height_m=1.73, sequences=None, max_frames=None, model=None, layout=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn eval_dataset<'py>(
     py: Python<'py>,
@@ -47,6 +47,7 @@ pub fn eval_dataset<'py>(
     calibration: Option<PathBuf>,
     protocol: &str,
     ground: Option<Vec<u32>>,
+    ignore: Option<Vec<u32>>,
     sensor_height_m: f32,
     sequences: Option<Vec<String>>,
     max_frames: Option<usize>,
@@ -64,6 +65,9 @@ pub fn eval_dataset<'py>(
     let mut proto = Protocol::named(protocol, sensor_height_m).map_err(dataset_error)?;
     if let Some(g) = &ground {
         proto = proto.with_ground(g).map_err(dataset_error)?;
+    }
+    if let Some(i) = &ignore {
+        proto = proto.with_ignored(i).map_err(dataset_error)?;
     }
     // Unknown methods and bad models are refused before any frame is read; each model file is
     // read once, every instance (one per sequence) built from it.

@@ -49,6 +49,9 @@ def test_scores_agree_with_the_command_line(dataset, cli, tmp_path):
     assert len(roads["methods"]["nitsch"]["frames"]) == 1
     pw = gt.eval_dataset(dataset, ["nitsch"], protocol="patchworkpp")
     assert 70 in pw["protocol"]["ignored"]
+    # More classes left out (WADS's falling snow would be `ignore=[110]`).
+    left = gt.eval_dataset(dataset, ["nitsch"], ground=[44, 48, 49, 60, 72], ignore=[40])
+    assert left["protocol"]["name"] == "semantickitti+ground+ignore" and 40 in left["protocol"]["ignored"]
 
 
 def test_bad_datasets_and_options_are_refused(dataset, tmp_path):
@@ -58,6 +61,8 @@ def test_bad_datasets_and_options_are_refused(dataset, tmp_path):
         gt.eval_dataset(dataset, ground=[40, 41])
     with pytest.raises(ValueError, match="--protocol"):
         gt.eval_dataset(dataset, protocol="kitti")
+    with pytest.raises(ValueError, match="--ignore.*not ground"):
+        gt.eval_dataset(dataset, ignore=[72])
     with pytest.raises(ValueError, match="unknown method"):
         gt.eval_dataset(dataset, ["nope"])
     with pytest.raises(ValueError, match="--sequences.*07"):
