@@ -65,11 +65,20 @@ def main():
     ap.add_argument("--ignore", help="class ids left out beside the protocol's, comma-separated")
     args = ap.parse_args()
     ignored = [0, 1] + ([70] if args.protocol == "patchworkpp" else [])
+    def class_ids(flag, text):
+        try:
+            ids = [int(x) for x in text.split(",")]
+        except ValueError:
+            sys.exit(f"{flag}: `{text}` is not a comma-separated list of class ids (e.g. 40,44,48)")
+        if any(not 0 <= i <= 0xFFFF for i in ids):
+            sys.exit(f"{flag}: class ids are 0 ..= 65535")
+        return ids
+
     ground = GROUND
-    if args.ground:
-        ground = np.array([int(x) for x in args.ground.split(",")], dtype=np.uint32)
-    if args.ignore:
-        ignored += [int(x) for x in args.ignore.split(",")]
+    if args.ground is not None:
+        ground = np.array(class_ids("--ground", args.ground), dtype=np.uint32)
+    if args.ignore is not None:
+        ignored += class_ids("--ignore", args.ignore)
     if np.isin(ground, ignored).any():
         sys.exit("--ground and --ignore share a class")
     tot = {"tp": 0, "fp": 0, "fn": 0, "tn": 0}

@@ -146,6 +146,13 @@ impl Protocol {
     /// # Ok::<(), classifier::dataset::DatasetError>(())
     /// ```
     pub fn with_ignored(mut self, ignored: &[u32]) -> Result<Self, DatasetError> {
+        if ignored.is_empty() {
+            return Err(DatasetError::Invalid {
+                flag: "--ignore",
+                value: "(empty)".to_string(),
+                allowed: "at least one class id".to_string(),
+            });
+        }
         let before = self.ignored.len();
         for &id in ignored {
             let class = class_id("--ignore", id)?;
@@ -211,6 +218,8 @@ mod tests {
         assert_eq!(d.clone().with_ignored(&[0, 1]).unwrap().name, "semantickitti");
         let e = d.clone().with_ignored(&[112]).unwrap_err().to_string();
         assert!(e.contains("--ignore") && e.contains("112"), "{e}");
+        let e = d.clone().with_ignored(&[]).unwrap_err().to_string();
+        assert!(e.contains("--ignore") && e.contains("empty"), "{e}");
         let e = d.clone().with_ignored(&[72]).unwrap_err().to_string();
         assert!(e.contains("--ignore") && e.contains("not ground"), "{e}");
         let e = d.with_ground(&[40, 110]).unwrap().with_ignored(&[110]).unwrap_err().to_string();
