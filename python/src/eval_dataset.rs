@@ -30,8 +30,8 @@ fn dataset_error(e: DatasetError) -> PyErr {
 /// `groundtruth classify` reads a `.bin` (ordered with `rig`'s beam table and mount, or
 /// `calibration`'s; a dataset written by `groundtruth dataset` without either: each sequence's own
 /// rig), under `protocol` (`semantickitti`, `patchworkpp`, `patchwork`; `ground` replaces its ground
-/// class ids, `ignore` leaves more classes out, e.g. `[110]`, WADS's falling snow). Returns a dict `{"dataset", "protocol", "range_bands", "methods": {name: {"pooled":
-/// {"precision", "recall", "f1", "iou", "accuracy", "tp", "fp", "tn", "fn", "points"},
+/// class ids, `ignore` leaves more classes out, e.g. `[110]`, WADS's falling snow). Returns a dict
+/// `{"dataset", "protocol", "range_bands", "methods": {name: {"pooled": {"precision", "recall", "f1", "iou", "accuracy", "tp", "fp", "tn", "fn", "points"},
 /// "frame_mean", "by_range", "worst_frame", "mean_classify_ms", "frames": [...]}}}`, the document of
 /// `groundtruth eval --dataset --json`. A folder of nuScenes sweeps with their lidarseg labels
 /// (`lidar/NAME.pcd.bin`, `lidarseg/NAME_lidarseg.bin`) is scored too; `layout` (`"kitti"`,

@@ -117,15 +117,15 @@ impl Protocol {
         }
         let mut set = BTreeSet::new();
         for &id in ground {
-            class_id("--ground", id)?;
-            if self.ignored.contains(&(id as u16)) {
+            let class = class_id("--ground", id)?;
+            if self.ignored.contains(&class) {
                 return Err(DatasetError::Invalid {
                     flag: "--ground",
                     value: id.to_string(),
                     allowed: format!("a class the protocol `{}` does not leave out", self.name),
                 });
             }
-            set.insert(id as u16);
+            set.insert(class);
         }
         if set != self.ground {
             self.name = format!("{}+ground", self.name);

@@ -86,7 +86,7 @@ impl Forest {
     /// [`Forest::margins_any`]. Four 16-cell chunks go through each tree together (64 cells, then
     /// the rest one chunk at a time): each tree's table and thresholds are loaded once for them, and
     /// four independent chains of compares, permutes and sums keep the core busy where one chain
-    /// waited on its own sum (a KITTI frame's trees 2.8 -> 1.6 ms on one core).
+    /// waited on its own sum (a KITTI frame's trees 2.9 -> 1.4 ms on one core).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,bmi1,bmi2")]
     fn margins_avx512(&self, columns: &[Vec<f32>], count: usize, out: &mut [f32]) {

@@ -374,19 +374,19 @@ impl ParticleTable {
         let mut rng = key.rng(Purpose::Weather);
         // One uniform: particles beat floor L iff u > P(none does) = S_L (S grows with L).
         let v = rng.random::<f64>();
+        let s_base = survival(base);
         let u = match candidate_chance {
             None => v,
             // A candidate keeps its particle with chance (1 - S_base) / q; given that, u is
             // uniform on (S_base, 1), as the one uniform above is given u > S_base.
             Some(q) => {
-                let s_base = survival(base);
                 if v * q >= 1.0 - s_base {
                     return None;
                 }
                 s_base + v * q
             }
         };
-        if survival(base) >= u {
+        if s_base >= u {
             return None;
         }
         // S_base < u; S_LEVELS = 1 >= u.
