@@ -230,11 +230,13 @@ impl OrderedCloud {
     }
 
     /// Cell index of `(plane, row, col)`.
+    #[inline]
     pub fn index(&self, plane: usize, row: usize, col: usize) -> usize {
         (plane * self.rows + row) * self.cols + col
     }
 
     /// Whether cell `i` holds a return.
+    #[inline]
     pub fn has_return(&self, i: usize) -> bool {
         self.range_m[i].is_finite()
     }

@@ -204,31 +204,32 @@ impl Nitsch {
 /// Decides the cells of planes > 0 from the plane-0 decisions `plane0` (module docs).
 pub fn echoes_from_plane0(cloud: &sim::OrderedCloud, plane0: &[bool], echo_match_m: f32, out: &mut [bool]) {
     let (rows, cols) = (cloud.rows, cloud.cols);
+    let cells = rows * cols;
     let pts = &cloud.point_in_vehicle;
     for plane in 1..cloud.planes {
-        for r in 0..rows {
-            for c in 0..cols {
-                let i = cloud.index(plane, r, c);
-                out[i] = false;
-                let p = pts[i];
-                if !is_valid(p) {
-                    continue;
-                }
-                let mut best = (echo_match_m * echo_match_m, None::<usize>);
-                for rr in r.saturating_sub(1)..=(r + 1).min(rows - 1) {
-                    for cc in c.saturating_sub(1)..=(c + 1).min(cols - 1) {
-                        let j = rr * cols + cc;
-                        let q: Vec3 = pts[j];
-                        if is_valid(q) {
-                            let d2 = p.distance_squared(q);
-                            if d2 <= best.0 {
-                                best = (d2, Some(j));
-                            }
+        let start = plane * cells;
+        let (plane_pts, plane_out) = (&pts[start..start + cells], &mut out[start..start + cells]);
+        plane_out.fill(false);
+        // Later echoes are few: most cells of these planes are no-returns.
+        for (k, &p) in plane_pts.iter().enumerate() {
+            if !is_valid(p) {
+                continue;
+            }
+            let (r, c) = (k / cols, k % cols);
+            let mut best = (echo_match_m * echo_match_m, None::<usize>);
+            for rr in r.saturating_sub(1)..=(r + 1).min(rows - 1) {
+                for cc in c.saturating_sub(1)..=(c + 1).min(cols - 1) {
+                    let j = rr * cols + cc;
+                    let q: Vec3 = pts[j];
+                    if is_valid(q) {
+                        let d2 = p.distance_squared(q);
+                        if d2 <= best.0 {
+                            best = (d2, Some(j));
                         }
                     }
                 }
-                out[i] = best.1.is_some_and(|j| plane0[j]);
             }
+            plane_out[k] = best.1.is_some_and(|j| plane0[j]);
         }
     }
 }

@@ -59,17 +59,22 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
         start[g] += start[g - 1];
     }
     let mut fill = start.clone();
-    let (mut tan, mut dist, mut az) = (vec![0f32; n_usable], vec![0f32; n_usable], vec![0f32; n_usable]);
-    for (p, &g) in points.iter().zip(rings) {
+    // Per slot, the point's index: azimuths are needed in the four fullest rings only.
+    let (mut tan, mut dist, mut source) = (vec![0f32; n_usable], vec![0f32; n_usable], vec![0u32; n_usable]);
+    for (k, (p, &g)) in points.iter().zip(rings).enumerate() {
         let v = p.xyz();
         if !usable(v) {
             continue;
         }
         let i = &mut fill[usize::from(g)];
         let d = (v.x * v.x + v.y * v.y).sqrt().max(1e-6);
-        (tan[*i], dist[*i], az[*i]) = (v.z / d, d, v.y.atan2(v.x));
+        (tan[*i], dist[*i], source[*i]) = (v.z / d, d, k as u32);
         *i += 1;
     }
+    let az = |i: usize| {
+        let v = points[source[i] as usize].xyz();
+        v.y.atan2(v.x)
+    };
     let span = |g: usize| start[g]..start[g + 1];
     let present: Vec<usize> = (0..=usize::from(MAX_RING_VALUE)).filter(|&g| !span(g).is_empty()).collect();
     if present.len() < 2 {
@@ -96,7 +101,7 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     let mut gaps = Vec::new();
     for &g in fullest.iter().take(4) {
         let mut a: Vec<f32> =
-            span(g).filter(|&i| dist[i] * (1.0 + tan[i] * tan[i]).sqrt() >= min_range_m).map(|i| az[i]).collect();
+            span(g).filter(|&i| dist[i] * (1.0 + tan[i] * tan[i]).sqrt() >= min_range_m).map(az).collect();
         a.sort_by(f32::total_cmp);
         gaps.extend(a.windows(2).map(|w| w[1] - w[0]).filter(|&s| s > 1e-4));
     }
