@@ -340,7 +340,13 @@ impl OrganizedLayout {
             }
             (rows.iter().map(|r| r.1).sum::<f64>() / rows.len() as f64) as f32
         };
-        let (a, b) = (spread(&row_major), spread(&column_major));
+        // Without no-returns only the column-by-column reading can win: its spread alone decides a
+        // layout that fails (the other reading's points are then not read).
+        let b = spread(&column_major);
+        if !has_zeros && b >= ORGANIZED_ROW_SPREAD_DEG {
+            return None;
+        }
+        let a = spread(&row_major);
         let (best, spread_best, spread_other) =
             if has_zeros && a <= b { (row_major, a, b) } else { (column_major, b, a) };
         (spread_best < ORGANIZED_ROW_SPREAD_DEG && spread_other > 2.0 * ORGANIZED_ROW_SPREAD_DEG).then_some(best)
