@@ -94,7 +94,7 @@ pub fn encode_layout(
     let t0 = (0..n).filter(|&i| cloud.has_return(i)).map(|i| cloud.time_s[i]).fold(f64::INFINITY, f64::min);
     let t0 = if t0.is_finite() { t0 } else { 0.0 };
     let to_file = |p: glam::Vec3| sensor_from_vehicle.map_or(p, |t| t.transform_point3(p));
-    let intensity = |i: usize| round_small(cloud.intensity[i].clamp(0.0, 1.0) * 255.0);
+    let intensity = |i: usize| (cloud.intensity[i].clamp(0.0, 1.0) * 255.0).round();
     let mut out;
     match layout {
         PcdLayout::Velodyne => {
@@ -108,22 +108,21 @@ pub fn encode_layout(
                 ("label", 'U', 4),
             ];
             let h = header(&fields, cols, rows);
-            // The body sized once and filled record by record (26 bytes; a growth check per field
-            // cost a third of the encoding).
             out = Vec::with_capacity(h.len() + n * 26);
             out.extend_from_slice(h.as_bytes());
-            out.resize(h.len() + n * 26, 0);
-            for (i, rec) in out[h.len()..].chunks_exact_mut(26).enumerate() {
-                let hit = cloud.has_return(i);
-                let p = to_file(cloud.point_in_vehicle[i]);
-                let xyz = if hit { [p.x, p.y, p.z] } else { [f32::NAN; 3] };
-                rec[0..4].copy_from_slice(&xyz[0].to_le_bytes());
-                rec[4..8].copy_from_slice(&xyz[1].to_le_bytes());
-                rec[8..12].copy_from_slice(&xyz[2].to_le_bytes());
-                rec[12..16].copy_from_slice(&(if hit { intensity(i) } else { 0.0 }).to_le_bytes());
-                rec[16..18].copy_from_slice(&((i / cols) as u16).to_le_bytes());
-                rec[18..22].copy_from_slice(&((cloud.time_s[i] - t0) as f32).to_le_bytes());
-                rec[22..26].copy_from_slice(&u32::from(if hit { cloud.label[i].0 } else { 0 }).to_le_bytes());
+            for r in 0..rows {
+                for c in 0..cols {
+                    let i = r * cols + c;
+                    let hit = cloud.has_return(i);
+                    let p = to_file(cloud.point_in_vehicle[i]);
+                    for v in [p.x, p.y, p.z] {
+                        out.extend_from_slice(&(if hit { v } else { f32::NAN }).to_le_bytes());
+                    }
+                    out.extend_from_slice(&(if hit { intensity(i) } else { 0.0 }).to_le_bytes());
+                    out.extend_from_slice(&(r as u16).to_le_bytes());
+                    out.extend_from_slice(&((cloud.time_s[i] - t0) as f32).to_le_bytes());
+                    out.extend_from_slice(&u32::from(if hit { cloud.label[i].0 } else { 0 }).to_le_bytes());
+                }
             }
         }
         PcdLayout::Ouster => {
@@ -169,19 +168,6 @@ pub fn encode_layout(
     Ok(out)
 }
 
-/// `x.round()` for `x` in `0 ..= 255` (an intensity), without libm's `roundf` call per point: the
-/// truncation is exact there and so is `x - t`, so ties go up, as `round` takes them away from 0.
-/// The same value as `x.round()` for every non-negative `x` below 2^23; other `x` go to `round`.
-#[inline]
-fn round_small(x: f32) -> f32 {
-    if (0.0..8_388_608.0).contains(&x) {
-        let t = (x as u32) as f32;
-        if x - t >= 0.5 { t + 1.0 } else { t }
-    } else {
-        x.round()
-    }
-}
-
 /// Writes `cloud` in `layout` at `path` (atomically). Returns the point count (`WIDTH * HEIGHT`).
 pub fn write_layout(
     path: &Path,
@@ -193,29 +179,4 @@ pub fn write_layout(
     let bytes = encode_layout(cloud, layout, ascii, sensor_from_vehicle)?;
     super::super::atomic::write_bytes_atomic(path, &bytes)?;
     Ok(if layout == PcdLayout::Groundtruth { cloud.len() } else { cloud.rows * cloud.cols })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::round_small;
-
-    #[test]
-    fn round_small_is_round_on_every_intensity_and_beyond() {
-        // A spread of f32 over 0 ..= 256, every tie k + 0.5 and its two neighbours, then values up
-        // to and past 2^23.
-        let mut x = 0.0f32;
-        while x <= 256.0 {
-            assert_eq!(round_small(x).to_bits(), x.round().to_bits(), "{x}");
-            x = f32::from_bits(x.to_bits() + 9_973);
-        }
-        for k in 0..256 {
-            let tie = k as f32 + 0.5;
-            for x in [f32::from_bits(tie.to_bits() - 1), tie, f32::from_bits(tie.to_bits() + 1)] {
-                assert_eq!(round_small(x).to_bits(), x.round().to_bits(), "{x}");
-            }
-        }
-        for x in [0.49999997f32, 0.5, 1.5, 2.5, 254.5, 8_388_607.5, 8_388_608.0, 1e9, -0.5, -3.7, f32::NAN] {
-            assert_eq!(round_small(x).to_bits(), x.round().to_bits(), "{x}");
-        }
-    }
 }
