@@ -37,6 +37,18 @@ pub const VEGETATION: u16 = 70;
 /// take beside SemanticKITTI's own: WADS's falling snow and the snow lying on the ground.
 pub const OTHER_DATASET_CLASSES: [(u16, &str); 2] = [(110, "active snowfall (WADS)"), (111, "accumulated snow (WADS)")];
 
+/// Refuses an empty class list given to `flag`.
+fn non_empty(flag: &'static str, ids: &[u32]) -> Result<(), DatasetError> {
+    if ids.is_empty() {
+        return Err(DatasetError::Invalid {
+            flag,
+            value: "(empty)".to_string(),
+            allowed: "at least one class id".to_string(),
+        });
+    }
+    Ok(())
+}
+
 /// `id` as a class id `flag` takes: a SemanticKITTI label id or one of [`OTHER_DATASET_CLASSES`].
 fn class_id(flag: &'static str, id: u32) -> Result<u16, DatasetError> {
     u16::try_from(id)
@@ -108,13 +120,7 @@ impl Protocol {
     /// The same protocol with another ground class set (`--ground`); every id must be a
     /// SemanticKITTI label id, and none may be ignored too.
     pub fn with_ground(mut self, ground: &[u32]) -> Result<Self, DatasetError> {
-        if ground.is_empty() {
-            return Err(DatasetError::Invalid {
-                flag: "--ground",
-                value: "(empty)".to_string(),
-                allowed: "at least one class id".to_string(),
-            });
-        }
+        non_empty("--ground", ground)?;
         let mut set = BTreeSet::new();
         for &id in ground {
             let class = class_id("--ground", id)?;
@@ -146,13 +152,7 @@ impl Protocol {
     /// # Ok::<(), classifier::dataset::DatasetError>(())
     /// ```
     pub fn with_ignored(mut self, ignored: &[u32]) -> Result<Self, DatasetError> {
-        if ignored.is_empty() {
-            return Err(DatasetError::Invalid {
-                flag: "--ignore",
-                value: "(empty)".to_string(),
-                allowed: "at least one class id".to_string(),
-            });
-        }
+        non_empty("--ignore", ignored)?;
         let before = self.ignored.len();
         for &id in ignored {
             let class = class_id("--ignore", id)?;
