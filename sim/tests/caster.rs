@@ -273,13 +273,26 @@ fn bvh_hits_equal_brute_force_bit_for_bit() {
         rays.iter().map(|r| brute_force(&mesh, r).map(|h| (h.t.to_bits(), h.triangle))).collect();
     let hits = expected.iter().filter(|h| h.is_some()).count();
     assert!(hits > 2_000 && hits < rays.len() - 500, "{hits} hits of {}: not a mixed set", rays.len());
-    for (packet_rays, coherent) in [(0, false), (0, true), (4, false), (8, true), (16, false), (32, false)] {
-        let bvh = BvhCaster::with_options(&mesh, BvhOptions { packet_rays, coherent, ..BvhOptions::default() });
+    for (layout, packet_rays, coherent) in [
+        (BvhLayout::Eight, 0, false),
+        (BvhLayout::Eight, 0, true),
+        (BvhLayout::Eight, 4, false),
+        (BvhLayout::Eight, 8, true),
+        (BvhLayout::Eight, 16, false),
+        (BvhLayout::Eight, 32, false),
+        (BvhLayout::Four, 0, false),
+        (BvhLayout::Four, 16, false),
+    ] {
+        let bvh = BvhCaster::with_options(&mesh, BvhOptions { layout, packet_rays, coherent, ..BvhOptions::default() });
         let bits = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.triangle));
         let batch: Vec<_> = bvh.cast_all(&rays).into_iter().map(bits).collect();
         let single: Vec<_> = rays.iter().map(|r| bits(bvh.cast(r))).collect();
         for (i, want) in expected.iter().enumerate() {
-            assert_eq!(batch[i], *want, "packet_rays {packet_rays}, coherent {coherent}: ray {i} {:?}", rays[i]);
+            assert_eq!(
+                batch[i], *want,
+                "{layout:?}, packet_rays {packet_rays}, coherent {coherent}: ray {i} {:?}",
+                rays[i]
+            );
             assert_eq!(single[i], *want, "one ray at a time: ray {i} {:?}", rays[i]);
         }
     }

@@ -1,5 +1,5 @@
-//! The production caster: an obvhs BVH2 (PLOC build, reinsertion, leaf collapse) turned into a
-//! 4-wide BVH with this crate's traversal (`wide4.rs`), and the watertight triangle test of
+//! The production caster: an obvhs BVH2 (PLOC build, reinsertion, leaf collapse) turned into an
+//! 8-wide BVH with this crate's traversal (`wide.rs`), and the watertight triangle test of
 //! [`super::watertight`]. obvhs's own BVH2 and CWBVH traversals stay selectable
 //! ([`BvhLayout`]) for comparison.
 //!
@@ -18,7 +18,7 @@
 //!   the triangle the previous ray hit is tested first to seed a short `t_max`.
 //! - Every ray gets the same closest hit as [`Caster::cast`], and the grouping depends only on the
 //!   batch, so results never depend on the thread count. Of triangles at exactly the same distance
-//!   (a shared edge, coplanar overlapping faces) the 4-wide tree reports the lowest mesh index, as
+//!   (a shared edge, coplanar overlapping faces) the wide trees report the lowest mesh index, as
 //!   the GPU backend does; the obvhs trees of [`BvhOptions`] may report another (a tie is not a
 //!   leak).
 
@@ -33,7 +33,7 @@ use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use obvhs::ray::{Ray as ORay, RayHit};
 
 use super::watertight::RayPre;
-use super::wide4::Wide4;
+use super::wide::Wide;
 use super::{Caster, Hit, Ray};
 use crate::scene::SceneMesh;
 
@@ -45,9 +45,13 @@ pub enum BvhLayout {
     /// Compressed wide BVH8 (obvhs `CwBvh`, SIMD node tests, up to 3 triangles per leaf).
     Wide,
     /// 4-wide BVH collapsed from the obvhs `Bvh2`, with this crate's nearest-first traversal
-    /// (structure-of-arrays slab tests of four children at once; see `wide4.rs`). The fastest.
-    #[default]
+    /// (structure-of-arrays slab tests of four children at once; see `wide.rs`).
     Four,
+    /// 8-wide BVH collapsed the same way, with the same traversal over eight children at once (one
+    /// 256-bit operation per plane with AVX2). The fastest: measured 1.3x [`BvhLayout::Four`] on
+    /// the fixture's fans, 1.25x on random rays (docs/benchmarks.md).
+    #[default]
+    Eight,
 }
 
 /// Build and traversal options of [`BvhCaster`] (the defaults are the fastest measured).
@@ -59,8 +63,9 @@ pub struct BvhOptions {
     /// same lane in the previous fan) to start with a short `t_max`.
     pub coherent: bool,
     /// Traverse groups of this many consecutive rays together in [`Caster::cast_batch`] (layout
-    /// [`BvhLayout::Four`] only; 4, 8, 16 or 32; 0 or 1: one ray at a time). A group whose
-    /// directions share one octant is traversed as a fan (interval slab tests, see `wide4.rs`);
+    /// [`BvhLayout::Four`] and [`BvhLayout::Eight`] only; 4, 8, 16 or 32; 0 or 1: one ray at a
+    /// time). A group whose directions share one octant is traversed as a fan (interval slab
+    /// tests, see `wide.rs`);
     /// other groups one ray at a time.
     pub packet_rays: usize,
     /// Largest number of triangles per leaf (binary: 1..=255, wide: 1..=3).
@@ -72,7 +77,7 @@ pub struct BvhOptions {
 impl Default for BvhOptions {
     fn default() -> Self {
         Self {
-            layout: BvhLayout::Four,
+            layout: BvhLayout::Eight,
             coherent: false,
             packet_rays: 16,
             max_prims_per_leaf: 4,
@@ -85,7 +90,8 @@ enum Tree {
     Empty,
     Binary(Bvh2),
     Wide(CwBvh),
-    Four(Wide4),
+    Four(Wide<4>),
+    Eight(Wide<8>),
 }
 
 /// Production caster: obvhs BVH + watertight triangles; rayon over rays in [`Caster::cast_all`].
@@ -157,14 +163,19 @@ impl BvhCaster {
             }
             BvhLayout::Four => {
                 collapse(&mut bvh2, options.max_prims_per_leaf.clamp(1, 255), 3.0);
-                (Tree::Four(Wide4::from_bvh2(&bvh2, |i| mesh.triangle(i as usize))), Vec::new())
+                let mut w = Wide::<4>::from_bvh2(&bvh2, |i| mesh.triangle(i as usize));
+                let tris = std::mem::take(&mut w.tris);
+                let order = w.order_to_triangle.clone(); // Also kept in the tree: its tie-break reads it.
+                return Self { tree: Tree::Four(w), tris, order_to_triangle: order, options, pad_m };
+            }
+            BvhLayout::Eight => {
+                collapse(&mut bvh2, options.max_prims_per_leaf.clamp(1, 255), 3.0);
+                let mut w = Wide::<8>::from_bvh2(&bvh2, |i| mesh.triangle(i as usize));
+                let tris = std::mem::take(&mut w.tris);
+                let order = w.order_to_triangle.clone();
+                return Self { tree: Tree::Eight(w), tris, order_to_triangle: order, options, pad_m };
             }
         };
-        if let Tree::Four(mut w) = tree {
-            let tris = std::mem::take(&mut w.tris);
-            let order = w.order_to_triangle.clone(); // Also kept in the tree: its tie-break reads it.
-            return Self { tree: Tree::Four(w), tris, order_to_triangle: order, options, pad_m };
-        }
         let tris = indices.iter().map(|&i| mesh.triangle(i as usize)).collect();
         Self { tree, tris, order_to_triangle: indices, options, pad_m }
     }
@@ -188,8 +199,10 @@ impl BvhCaster {
         seed: Option<(u32, f32)>,
         stack: &mut Vec<(u32, f32)>,
     ) -> Option<(u32, f32)> {
-        if let Tree::Four(w) = &self.tree {
-            return w.cast(pre, ray.dir, &self.tris, seed, stack);
+        match &self.tree {
+            Tree::Four(w) => return w.cast(pre, ray.dir, &self.tris, seed, stack),
+            Tree::Eight(w) => return w.cast(pre, ray.dir, &self.tris, seed, stack),
+            _ => {}
         }
         let limit = seed.map_or(ray.t_max, |(_, t)| t);
         // obvhs accepts `t < ray.tmax`: widen by one ulp for an inclusive `t_max` when unseeded,
@@ -206,15 +219,16 @@ impl BvhCaster {
             Tree::Empty => false,
             Tree::Binary(b) => b.ray_traverse(o, &mut hit, test),
             Tree::Wide(w) => w.ray_traverse(o, &mut hit, test),
-            Tree::Four(_) => false, // Handled above.
+            Tree::Four(_) | Tree::Eight(_) => false, // Handled above.
         };
         if found { Some((hit.primitive_id, hit.t)) } else { seed }
     }
 
-    /// [`Caster::cast_batch`] for the 4-wide tree, `N` rays at a time.
-    fn batch_packets<const N: usize>(
+    /// [`Caster::cast_batch`] for the wide trees, `N` rays at a time.
+    #[inline(always)]
+    fn batch_packets<const W: usize, const N: usize>(
         &self,
-        w: &Wide4,
+        w: &Wide<W>,
         rays: &[Ray],
         out: &mut [Option<Hit>],
         stack: &mut Vec<(u32, f32)>,
@@ -251,6 +265,56 @@ impl BvhCaster {
         }
     }
 
+    /// [`Caster::cast_batch`] in fans of [`BvhOptions::packet_rays`] rays, compiled for AVX2 where
+    /// the CPU has it (the slab tests of eight children then take one 256-bit operation per plane;
+    /// plain IEEE operations only, so the same bits).
+    fn batch_fans<const W: usize>(
+        &self,
+        w: &Wide<W>,
+        rays: &[Ray],
+        out: &mut [Option<Hit>],
+        stack: &mut Vec<(u32, f32)>,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.batch_fans_avx2(w, rays, out, stack);
+            }
+        }
+        self.batch_fans_body(w, rays, out, stack);
+    }
+
+    /// [`BvhCaster::batch_fans_body`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn batch_fans_avx2<const W: usize>(
+        &self,
+        w: &Wide<W>,
+        rays: &[Ray],
+        out: &mut [Option<Hit>],
+        stack: &mut Vec<(u32, f32)>,
+    ) {
+        self.batch_fans_body(w, rays, out, stack);
+    }
+
+    #[inline(always)]
+    fn batch_fans_body<const W: usize>(
+        &self,
+        w: &Wide<W>,
+        rays: &[Ray],
+        out: &mut [Option<Hit>],
+        stack: &mut Vec<(u32, f32)>,
+    ) {
+        match self.options.packet_rays {
+            2..=4 => self.batch_packets::<W, 4>(w, rays, out, stack),
+            5..=8 => self.batch_packets::<W, 8>(w, rays, out, stack),
+            9..=16 => self.batch_packets::<W, 16>(w, rays, out, stack),
+            _ => self.batch_packets::<W, 32>(w, rays, out, stack),
+        }
+    }
+
     fn to_hit(&self, (prim, t): (u32, f32)) -> Hit {
         Hit { t, triangle: self.order_to_triangle[prim as usize] }
     }
@@ -264,16 +328,12 @@ impl Caster for BvhCaster {
 
     fn cast_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         let mut stack = Vec::with_capacity(64);
-        if let Tree::Four(w) = &self.tree
-            && self.options.packet_rays > 1
-        {
-            match self.options.packet_rays {
-                2..=4 => self.batch_packets::<4>(w, rays, out, &mut stack),
-                5..=8 => self.batch_packets::<8>(w, rays, out, &mut stack),
-                9..=16 => self.batch_packets::<16>(w, rays, out, &mut stack),
-                _ => self.batch_packets::<32>(w, rays, out, &mut stack),
+        if self.options.packet_rays > 1 {
+            match &self.tree {
+                Tree::Four(w) => return self.batch_fans(w, rays, out, &mut stack),
+                Tree::Eight(w) => return self.batch_fans(w, rays, out, &mut stack),
+                _ => {}
             }
-            return;
         }
         if !self.options.coherent {
             for (r, o) in rays.iter().zip(out.iter_mut()) {

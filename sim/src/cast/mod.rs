@@ -11,7 +11,7 @@ pub mod gpu;
 mod reference;
 mod tri_pack;
 pub mod watertight;
-mod wide4;
+mod wide;
 
 pub use beams::{Beam, BeamSet, BeamSetError};
 pub use bvh::{BvhCaster, BvhLayout, BvhOptions};

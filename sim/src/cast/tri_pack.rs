@@ -126,7 +126,7 @@ mod tests {
             for first in (0..600).step_by(4).take(150) {
                 let count = 1 + (first / 4) % 4;
                 let slice = &tris[first..first + count];
-                // The leaf loop of `wide4.rs` (layout index = mesh index here: a tie keeps the first).
+                // The leaf loop of `wide.rs` (layout index = mesh index here: a tie keeps the first).
                 let mut want: (Option<(usize, u32)>, f32) = (None, pre.t_max);
                 for (j, [a, b, c]) in slice.iter().enumerate() {
                     if let Some(t) = pre.intersect(*a, *b, *c, want.1)

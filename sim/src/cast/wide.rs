@@ -1,11 +1,14 @@
-//! A 4-wide BVH collapsed from an obvhs `Bvh2`, with a closest-hit traversal that tests the four
-//! child boxes of a node together (structure-of-arrays, so the slab tests vectorise) and visits
-//! children nearest first. Triangles are stored in the order the leaves are laid out, and each
+//! A `W`-wide BVH (4 or 8) collapsed from an obvhs `Bvh2`, with a closest-hit traversal that tests
+//! the `W` child boxes of a node together (structure-of-arrays, so the slab tests vectorise: one
+//! 256-bit operation per plane for eight children with AVX2) and visits children nearest first. Triangles are stored in the order the leaves are laid out, and each
 //! leaf's triangles again four to a SIMD pack ([`TriPack`], `tri_pack.rs`): one ray tests a leaf
 //! of up to four triangles at once.
 //!
 //! Collapse rule: starting from a binary node's two children, the inner child with the largest
-//! surface area is replaced by its own two children until there are four or only leaves remain.
+//! surface area is replaced by its own two children until there are `W` or only leaves remain.
+//!
+//! Fans of rays ([`Wide::cast_fan`]) test inner nodes once for the whole fan (interval slab
+//! tests) and a leaf child against all the fan's rays at once (the rays in the lanes).
 
 use glam::Vec3;
 use obvhs::bvh2::Bvh2;
@@ -16,28 +19,28 @@ use super::watertight::RayPre;
 /// Marks an unused child slot.
 const EMPTY: u32 = u32::MAX;
 
-/// One node: bounds of up to four children, structure-of-arrays.
+/// One node: bounds of up to `W` children, structure-of-arrays.
 #[derive(Clone, Copy, Debug)]
-struct Node4 {
+struct Node<const W: usize> {
     /// `bounds[a][k]`: axis `a` minimum (a = 0..3) and maximum (a = 3..6) of child `k`.
-    bounds: [[f32; 4]; 6],
+    bounds: [[f32; W]; 6],
     /// Inner child: node index; leaf child: its first [`TriPack`].
-    child: [u32; 4],
+    child: [u32; W],
     /// 0 for an inner child, the triangle count for a leaf, [`EMPTY`] for an unused slot.
-    count: [u32; 4],
+    count: [u32; W],
 }
 
-impl Node4 {
+impl<const W: usize> Node<W> {
     fn empty() -> Self {
-        let mut bounds = [[f32::INFINITY; 4]; 6];
-        bounds[3..].iter_mut().for_each(|b| *b = [f32::NEG_INFINITY; 4]);
-        Self { bounds, child: [0; 4], count: [EMPTY; 4] }
+        let mut bounds = [[f32::INFINITY; W]; 6];
+        bounds[3..].iter_mut().for_each(|b| *b = [f32::NEG_INFINITY; W]);
+        Self { bounds, child: [0; W], count: [EMPTY; W] }
     }
 }
 
-/// The 4-wide BVH and its triangles in layout order.
-pub(super) struct Wide4 {
-    nodes: Vec<Node4>,
+/// The `W`-wide BVH and its triangles in layout order.
+pub(super) struct Wide<const W: usize> {
+    nodes: Vec<Node<W>>,
     /// Triangle corners in layout order.
     pub(super) tris: Vec<[Vec3; 3]>,
     /// Each leaf's triangles, four to a pack (a leaf's packs are consecutive).
@@ -57,8 +60,8 @@ struct RayBox {
     far: [usize; 3],
 }
 
-impl Wide4 {
-    /// Collapses `bvh2` (with `primitive_indices` into `tris_of_mesh`) into a 4-wide BVH.
+impl<const W: usize> Wide<W> {
+    /// Collapses `bvh2` (with `primitive_indices` into `tris_of_mesh`) into a `W`-wide BVH.
     pub(super) fn from_bvh2(bvh2: &Bvh2, tri_of: impl Fn(u32) -> [Vec3; 3]) -> Self {
         let mut w = Self {
             nodes: Vec::new(),
@@ -76,7 +79,7 @@ impl Wide4 {
             w.root_leaf = Some((first, root.prim_count));
             return w;
         }
-        w.nodes.push(Node4::empty());
+        w.nodes.push(Node::empty());
         w.fill(bvh2, 0, 0, &tri_of);
         w
     }
@@ -99,7 +102,7 @@ impl Wide4 {
     fn fill(&mut self, bvh2: &Bvh2, node: usize, slot: usize, tri_of: &impl Fn(u32) -> [Vec3; 3]) {
         let first = bvh2.nodes[node].first_index as usize;
         let mut kids = vec![first, first + 1];
-        while kids.len() < 4 {
+        while kids.len() < W {
             let best = kids
                 .iter()
                 .enumerate()
@@ -124,7 +127,7 @@ impl Wide4 {
                 self.nodes[slot].count[j] = n.prim_count;
             } else {
                 let child = self.nodes.len();
-                self.nodes.push(Node4::empty());
+                self.nodes.push(Node::empty());
                 self.nodes[slot].child[j] = child as u32;
                 self.nodes[slot].count[j] = 0;
                 self.fill(bvh2, k, child, tri_of);
@@ -135,7 +138,7 @@ impl Wide4 {
     /// Closest hit `(layout index, t)` of the ray prepared in `pre` against `tris` (this tree's
     /// triangles in layout order, taken out of `self.tris` by the caller), not farther than `seed`'s `t`
     /// (and, with a seed, strictly closer than it, so a tie keeps the seed).
-    #[inline]
+    #[inline(always)]
     pub(super) fn cast(
         &self,
         pre: &RayPre,
@@ -166,11 +169,11 @@ impl Wide4 {
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let (t_near, hit) = slab4(n, &rb, best_t);
+            let (t_near, hit) = slab(n, &rb, best_t);
             // Children met, nearest first.
             let (order, m) = nearest_first(&t_near, &hit);
             // Leaves at once (they shorten `best_t` for their siblings), inner children after.
-            let mut inner = [(0u32, 0.0f32); 4];
+            let mut inner = [(0u32, 0.0f32); W];
             let mut q = 0;
             for &(k, t) in &order[..m] {
                 if n.count[k] == 0 {
@@ -227,28 +230,28 @@ fn safe_inv(d: f32) -> f32 {
     if d.abs() < 1e-30 { 1e30f32.copysign(d) } else { 1.0 / d }
 }
 
-/// Slab test of the four children: entry distances and which children the ray meets in `[0, t_max]`.
+/// Slab test of the `W` children: entry distances and which children the ray meets in `[0, t_max]`.
 #[inline(always)]
-fn slab4(n: &Node4, rb: &RayBox, t_max: f32) -> ([f32; 4], [bool; 4]) {
-    let mut t_near = [0.0f32; 4];
-    let mut t_far = [t_max; 4];
+fn slab<const W: usize>(n: &Node<W>, rb: &RayBox, t_max: f32) -> ([f32; W], [bool; W]) {
+    let mut t_near = [0.0f32; W];
+    let mut t_far = [t_max; W];
     for a in 0..3 {
         let (o, i) = (rb.origin[a], rb.inv_dir[a]);
         let lo = &n.bounds[rb.near[a]];
         let hi = &n.bounds[rb.far[a]];
-        for k in 0..4 {
+        for k in 0..W {
             t_near[k] = t_near[k].max((lo[k] - o) * i);
             t_far[k] = t_far[k].min((hi[k] - o) * i);
         }
     }
-    let mut hit = [false; 4];
-    for k in 0..4 {
+    let mut hit = [false; W];
+    for k in 0..W {
         hit[k] = t_near[k] <= t_far[k];
     }
     (t_near, hit)
 }
 
-impl Wide4 {
+impl<const W: usize> Wide<W> {
     /// Closest hits of `N` rays whose directions have the same sign on every axis (a small fan of
     /// LiDAR beams), or `false` without touching `best` when they do not.
     ///
@@ -258,8 +261,9 @@ impl Wide4 {
     /// smallest and the largest of the four products `(b - o) i` at the interval corners (the product
     /// is bilinear); a node is entered when `max_axis(min entry) <= min_axis(max exit)`, a superset of
     /// "some ray meets the box". Leaves get an exact per-ray slab test before their triangles are
-    /// tested for that ray, so each ray gets the same closest hit as [`Wide4::cast`] (up to exact
+    /// tested for that ray, so each ray gets the same closest hit as [`Wide::cast`] (up to exact
     /// ties).
+    #[inline(always)]
     pub(super) fn cast_fan<const N: usize>(
         &self,
         pres: &[RayPre; N],
@@ -291,7 +295,10 @@ impl Wide4 {
         let far: [usize; 3] = std::array::from_fn(|a| a + usize::from(i_lo[a] >= 0.0) * 3);
         let walk = FanWalk {
             fan: Fan { o_lo, o_hi, i_lo, i_hi },
-            rays: std::array::from_fn(|r| RayBox { origin: pres[r].origin.to_array(), inv_dir: inv[r], near, far }),
+            rays: RaysSoa {
+                origin: std::array::from_fn(|a| std::array::from_fn(|r| pres[r].origin[a])),
+                inv_dir: std::array::from_fn(|a| std::array::from_fn(|r| inv[r][a])),
+            },
             near,
             far,
         };
@@ -303,8 +310,9 @@ impl Wide4 {
         true
     }
 
-    /// The traversal of [`Wide4::cast_fan`] for one shared origin (`ONE_ORIGIN`) or an origin
+    /// The traversal of [`Wide::cast_fan`] for one shared origin (`ONE_ORIGIN`) or an origin
     /// interval.
+    #[inline(always)]
     fn walk_fan<const N: usize, const ONE_ORIGIN: bool>(
         &self,
         walk: &FanWalk<N>,
@@ -313,7 +321,7 @@ impl Wide4 {
         best: &mut [Option<(u32, f32)>; N],
         stack: &mut Vec<(u32, f32)>,
     ) {
-        let FanWalk { fan, rays: rbs, near, far } = walk;
+        let FanWalk { fan, rays: soa, near, far } = walk;
         let mut best_t = [0.0f32; N];
         for r in 0..N {
             best_t[r] = best[r].map_or(pres[r].t_max, |s| s.1);
@@ -323,20 +331,18 @@ impl Wide4 {
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let (t_near, hit) = slab4_fan::<ONE_ORIGIN>(n, fan, near, far, far_t);
+            let (t_near, hit) = slab_fan::<W, ONE_ORIGIN>(n, fan, near, far, far_t);
             let (order, m) = nearest_first(&t_near, &hit);
-            let mut inner = [(0u32, 0.0f32); 4];
+            let mut inner = [(0u32, 0.0f32); W];
             let mut q = 0;
-            let mut leaf_hits: Option<[[bool; 4]; N]> = None;
             for &(k, t) in &order[..m] {
                 if n.count[k] == 0 {
                     inner[q] = (n.child[k], t);
                     q += 1;
                 } else {
-                    let per_ray =
-                        leaf_hits.get_or_insert_with(|| std::array::from_fn(|r| slab4(n, &rbs[r], best_t[r]).1));
+                    let per_ray = slab_rays(n, k, soa, near, far, &best_t);
                     for r in 0..N {
-                        if per_ray[r][k] {
+                        if per_ray[r] {
                             self.leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
                         }
                     }
@@ -351,13 +357,48 @@ impl Wide4 {
     }
 }
 
-/// A fan of `N` rays set up for [`Wide4::cast_fan`]'s traversal: its extent, each ray's slab setup,
+/// A fan of `N` rays set up for [`Wide::cast_fan`]'s traversal: its extent, each ray's slab setup,
 /// and the near and far bound of each axis (the same for every ray of the fan).
 struct FanWalk<const N: usize> {
     fan: Fan,
-    rays: [RayBox; N],
+    rays: RaysSoa<N>,
     near: [usize; 3],
     far: [usize; 3],
+}
+
+/// The rays of a fan, structure-of-arrays: `origin[a][r]` and `inv_dir[a][r]` are axis `a` of
+/// ray `r`'s origin and inverse direction (as in its [`RayBox`]).
+struct RaysSoa<const N: usize> {
+    origin: [[f32; N]; 3],
+    inv_dir: [[f32; N]; 3],
+}
+
+/// Slab test of child `k` of `n` against every ray of a fan at once (the rays in the lanes): for
+/// each ray the operations [`slab`] does for that child, in the same order, so the same decision.
+#[inline(always)]
+fn slab_rays<const W: usize, const N: usize>(
+    n: &Node<W>,
+    k: usize,
+    rays: &RaysSoa<N>,
+    near: &[usize; 3],
+    far: &[usize; 3],
+    t_max: &[f32; N],
+) -> [bool; N] {
+    let mut t_near = [0.0f32; N];
+    let mut t_far = *t_max;
+    for a in 0..3 {
+        let (lo, hi) = (n.bounds[near[a]][k], n.bounds[far[a]][k]);
+        let (o, i) = (&rays.origin[a], &rays.inv_dir[a]);
+        for r in 0..N {
+            t_near[r] = t_near[r].max((lo - o[r]) * i[r]);
+            t_far[r] = t_far[r].min((hi - o[r]) * i[r]);
+        }
+    }
+    let mut hit = [false; N];
+    for r in 0..N {
+        hit[r] = t_near[r] <= t_far[r];
+    }
+    hit
 }
 
 /// The extent of a fan of rays: origins and inverse directions per axis.
@@ -368,31 +409,31 @@ struct Fan {
     i_hi: [f32; 3],
 }
 
-/// Interval slab test of the four children against a fan of rays (one direction sign per axis):
+/// Interval slab test of the `W` children against a fan of rays (one direction sign per axis):
 /// the smallest possible entry distance and whether some ray of the fan may meet the child within
 /// `[0, t_max]`. `ONE_ORIGIN`: all rays start at `o_lo` (two products per plane instead of four).
 #[inline(always)]
-fn slab4_fan<const ONE_ORIGIN: bool>(
-    n: &Node4,
+fn slab_fan<const W: usize, const ONE_ORIGIN: bool>(
+    n: &Node<W>,
     fan: &Fan,
     near: &[usize; 3],
     far: &[usize; 3],
     t_max: f32,
-) -> ([f32; 4], [bool; 4]) {
-    let mut t_near = [0.0f32; 4];
-    let mut t_far = [t_max; 4];
+) -> ([f32; W], [bool; W]) {
+    let mut t_near = [0.0f32; W];
+    let mut t_far = [t_max; W];
     for a in 0..3 {
         let lo = &n.bounds[near[a]];
         let hi = &n.bounds[far[a]];
         let (o_lo, o_hi, i_lo, i_hi) = (fan.o_lo[a], fan.o_hi[a], fan.i_lo[a], fan.i_hi[a]);
         if ONE_ORIGIN {
-            for k in 0..4 {
+            for k in 0..W {
                 let (p, q) = (lo[k] - o_lo, hi[k] - o_lo);
                 t_near[k] = t_near[k].max((p * i_lo).min(p * i_hi));
                 t_far[k] = t_far[k].min((q * i_lo).max(q * i_hi));
             }
         } else {
-            for k in 0..4 {
+            for k in 0..W {
                 // (b - o) * i is bilinear in (o, i): its extremes are at the corners.
                 let (p0, p1) = (lo[k] - o_hi, lo[k] - o_lo);
                 let entry = (p0 * i_lo).min(p0 * i_hi).min((p1 * i_lo).min(p1 * i_hi));
@@ -403,8 +444,8 @@ fn slab4_fan<const ONE_ORIGIN: bool>(
             }
         }
     }
-    let mut hit = [false; 4];
-    for k in 0..4 {
+    let mut hit = [false; W];
+    for k in 0..W {
         hit[k] = t_near[k] <= t_far[k] && n.count[k] != EMPTY;
     }
     (t_near, hit)
@@ -413,10 +454,10 @@ fn slab4_fan<const ONE_ORIGIN: bool>(
 /// The children a ray meets (`hit`), as `(child, entry distance)` nearest first (an insertion sort:
 /// equal distances keep the child order), and how many there are.
 #[inline(always)]
-fn nearest_first(t_near: &[f32; 4], hit: &[bool; 4]) -> ([(usize, f32); 4], usize) {
-    let mut order = [(0usize, 0.0f32); 4];
+fn nearest_first<const W: usize>(t_near: &[f32; W], hit: &[bool; W]) -> ([(usize, f32); W], usize) {
+    let mut order = [(0usize, 0.0f32); W];
     let mut m = 0;
-    for k in 0..4 {
+    for k in 0..W {
         if hit[k] {
             let mut i = m;
             while i > 0 && order[i - 1].1 > t_near[k] {
