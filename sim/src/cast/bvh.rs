@@ -80,7 +80,7 @@ impl Default for BvhOptions {
             layout: BvhLayout::Eight,
             coherent: false,
             packet_rays: 16,
-            max_prims_per_leaf: 4,
+            max_prims_per_leaf: 8,
             reinsertion_ratio: 0.02,
         }
     }

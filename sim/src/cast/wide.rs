@@ -171,7 +171,7 @@ impl<const W: usize> Wide<W> {
             let n = &self.nodes[node as usize];
             let (t_near, hit) = slab(n, &rb, best_t);
             // Children met, nearest first.
-            let (order, m) = nearest_first(&t_near, &hit);
+            let (order, m) = nearest_first(&t_near, hit);
             // Leaves at once (they shorten `best_t` for their siblings), inner children after.
             let mut inner = [(0u32, 0.0f32); W];
             let mut q = 0;
@@ -230,9 +230,10 @@ fn safe_inv(d: f32) -> f32 {
     if d.abs() < 1e-30 { 1e30f32.copysign(d) } else { 1.0 / d }
 }
 
-/// Slab test of the `W` children: entry distances and which children the ray meets in `[0, t_max]`.
+/// Slab test of the `W` children: entry distances and which children the ray meets in `[0, t_max]`
+/// (bit `k` for child `k`).
 #[inline(always)]
-fn slab<const W: usize>(n: &Node<W>, rb: &RayBox, t_max: f32) -> ([f32; W], [bool; W]) {
+fn slab<const W: usize>(n: &Node<W>, rb: &RayBox, t_max: f32) -> ([f32; W], u32) {
     let mut t_near = [0.0f32; W];
     let mut t_far = [t_max; W];
     for a in 0..3 {
@@ -244,9 +245,9 @@ fn slab<const W: usize>(n: &Node<W>, rb: &RayBox, t_max: f32) -> ([f32; W], [boo
             t_far[k] = t_far[k].min((hi[k] - o) * i);
         }
     }
-    let mut hit = [false; W];
+    let mut hit = 0u32;
     for k in 0..W {
-        hit[k] = t_near[k] <= t_far[k];
+        hit |= u32::from(t_near[k] <= t_far[k]) << k;
     }
     (t_near, hit)
 }
@@ -332,7 +333,7 @@ impl<const W: usize> Wide<W> {
         loop {
             let n = &self.nodes[node as usize];
             let (t_near, hit) = slab_fan::<W, ONE_ORIGIN>(n, fan, near, far, far_t);
-            let (order, m) = nearest_first(&t_near, &hit);
+            let (order, m) = nearest_first(&t_near, hit);
             let mut inner = [(0u32, 0.0f32); W];
             let mut q = 0;
             for &(k, t) in &order[..m] {
@@ -340,11 +341,11 @@ impl<const W: usize> Wide<W> {
                     inner[q] = (n.child[k], t);
                     q += 1;
                 } else {
-                    let per_ray = slab_rays(n, k, soa, near, far, &best_t);
-                    for r in 0..N {
-                        if per_ray[r] {
-                            self.leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
-                        }
+                    let mut per_ray = slab_rays(n, k, soa, near, far, &best_t);
+                    while per_ray != 0 {
+                        let r = per_ray.trailing_zeros() as usize;
+                        per_ray &= per_ray - 1;
+                        self.leaf(tris, &pres[r], n.child[k], n.count[k], &mut best[r], &mut best_t[r]);
                     }
                     far_t = best_t.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
                 }
@@ -383,7 +384,7 @@ fn slab_rays<const W: usize, const N: usize>(
     near: &[usize; 3],
     far: &[usize; 3],
     t_max: &[f32; N],
-) -> [bool; N] {
+) -> u32 {
     let mut t_near = [0.0f32; N];
     let mut t_far = *t_max;
     for a in 0..3 {
@@ -394,9 +395,9 @@ fn slab_rays<const W: usize, const N: usize>(
             t_far[r] = t_far[r].min((hi - o[r]) * i[r]);
         }
     }
-    let mut hit = [false; N];
+    let mut hit = 0u32;
     for r in 0..N {
-        hit[r] = t_near[r] <= t_far[r];
+        hit |= u32::from(t_near[r] <= t_far[r]) << r;
     }
     hit
 }
@@ -419,7 +420,7 @@ fn slab_fan<const W: usize, const ONE_ORIGIN: bool>(
     near: &[usize; 3],
     far: &[usize; 3],
     t_max: f32,
-) -> ([f32; W], [bool; W]) {
+) -> ([f32; W], u32) {
     let mut t_near = [0.0f32; W];
     let mut t_far = [t_max; W];
     for a in 0..3 {
@@ -444,21 +445,24 @@ fn slab_fan<const W: usize, const ONE_ORIGIN: bool>(
             }
         }
     }
-    let mut hit = [false; W];
+    let mut hit = 0u32;
     for k in 0..W {
-        hit[k] = t_near[k] <= t_far[k] && n.count[k] != EMPTY;
+        hit |= u32::from(t_near[k] <= t_far[k] && n.count[k] != EMPTY) << k;
     }
     (t_near, hit)
 }
 
-/// The children a ray meets (`hit`), as `(child, entry distance)` nearest first (an insertion sort:
+/// The children a ray meets (`hit`, bit `k` for child `k`), as `(child, entry distance)` nearest first (an insertion sort:
 /// equal distances keep the child order), and how many there are.
 #[inline(always)]
-fn nearest_first<const W: usize>(t_near: &[f32; W], hit: &[bool; W]) -> ([(usize, f32); W], usize) {
+fn nearest_first<const W: usize>(t_near: &[f32; W], hit: u32) -> ([(usize, f32); W], usize) {
     let mut order = [(0usize, 0.0f32); W];
     let mut m = 0;
-    for k in 0..W {
-        if hit[k] {
+    let mut todo = hit;
+    while todo != 0 {
+        let k = todo.trailing_zeros() as usize;
+        todo &= todo - 1;
+        {
             let mut i = m;
             while i > 0 && order[i - 1].1 > t_near[k] {
                 order[i] = order[i - 1];
