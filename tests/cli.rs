@@ -2,6 +2,8 @@
 //! of it (one link instead of one per file, and the tests of every file run side by side).
 //! Run one file's tests with `cargo test -p groundtruth-cli --test cli FILE::`.
 
+#[path = "cli_bench_raycast.rs"]
+mod cli_bench_raycast;
 #[path = "cli_dataset.rs"]
 mod cli_dataset;
 #[path = "cli_gpu.rs"]

@@ -127,7 +127,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // per call as a scan's pipeline casts together.
     let key = sim::cast::new_ray_set_key();
     let hits: Vec<Option<sim::cast::Hit>> = pool.install(|| match &source {
-        Source::Rays(one) => (0..a.frames).flat_map(|_| caster.cast_all_resident(key, one)).collect(),
+        // Frame by frame; the hits of the first frame are kept as they come (a copy of all hits
+        // into one vector grown by doubling was 5-10 % of the casting time of a 4 M-ray frame).
+        Source::Rays(one) => {
+            let mut hits = caster.cast_all_resident(key, one);
+            for _ in 1..a.frames {
+                hits.extend(caster.cast_all_resident(key, one));
+            }
+            hits
+        }
         Source::Beams(beams, poses) => {
             poses.chunks(beams.frames_per_call()).flat_map(|p| caster.cast_beams(beams, p)).collect()
         }

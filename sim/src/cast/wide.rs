@@ -191,6 +191,36 @@ impl<const W: usize> Wide<W> {
         }
     }
 
+    /// Asks the CPU to start loading the triangle packs of the leaf children of `n` in `hit` (bit `k`
+    /// for child `k`): a fan's leaf tests otherwise wait on memory (the packs of a large scene do
+    /// not fit in the caches).
+    #[inline(always)]
+    fn prefetch_leaves(&self, n: &Node<W>, hit: u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let mut todo = hit;
+            while todo != 0 {
+                let k = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let count = n.count[k];
+                if count == 0 {
+                    continue;
+                }
+                let first = n.child[k] as usize;
+                let packs = &self.packs[first..first + count.div_ceil(4) as usize];
+                let bytes = std::mem::size_of_val(packs);
+                let base = packs.as_ptr().cast::<i8>();
+                for offset in (0..bytes).step_by(64) {
+                    // SAFETY: `base + offset` lies within `packs`; a prefetch never faults.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(base.add(offset));
+                    }
+                }
+            }
+        }
+    }
+
     /// The closest hit among a leaf's `count` triangles (packs from `first_pack` on, tested in
     /// layout order); of triangles at exactly the same distance (a shared edge, coplanar overlapping
     /// faces), the one with the lowest mesh index, so that every layout of the tree and the GPU
@@ -333,6 +363,7 @@ impl<const W: usize> Wide<W> {
         loop {
             let n = &self.nodes[node as usize];
             let (t_near, hit) = slab_fan::<W, ONE_ORIGIN>(n, fan, near, far, far_t);
+            self.prefetch_leaves(n, hit);
             let (order, m) = nearest_first(&t_near, hit);
             let mut inner = [(0u32, 0.0f32); W];
             let mut q = 0;
