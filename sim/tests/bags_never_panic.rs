@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use sim::io::pcd::PcdLayout;
 use sim::io::ros2::messages::{Header, from_cdr};
 use sim::io::ros2::pointcloud2::{frame, from_pcd};
-use sim::io::ros2::{Bag, BagWriter, PointCloud2};
+use sim::io::ros2::{Bag, BagCompression, BagWriter, PointCloud2};
 use sim::{OrderedCloud, SemanticClass};
 
 /// A bag of two small clouds on `/points`, as bytes of its one MCAP file.
@@ -26,7 +26,9 @@ fn valid_bag() -> Vec<u8> {
     let pcd = sim::io::pcd::encode_layout(&c, PcdLayout::Velodyne, false, None).unwrap();
     let msg = from_pcd(&pcd, Header::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let mut w = BagWriter::create(&dir.path().join("b")).unwrap();
+    // zstd chunks where this build writes them (the default), else uncompressed ones.
+    let compression = if cfg!(feature = "bag-compression") { BagCompression::Zstd } else { BagCompression::None };
+    let mut w = BagWriter::create_with(&dir.path().join("b"), compression).unwrap();
     for k in 0..2 {
         w.write_pointcloud("/points", &msg, k * 100, &BTreeMap::new()).unwrap();
     }
