@@ -303,6 +303,62 @@ impl RowGuess {
     }
 }
 
+crate::cpu::dispatch_by_isa! {
+    /// Per point `i`: of the five candidate rows `candidates[guess[i]]` (each `[vertical offset,
+    /// 0.5 h h, tan(elevation), along offset]`), the fine `tan(elevation)` of the point (height
+    /// `z[i]`, `inv_d[i] = 1 / horizontal distance`) seen from the row whose value is nearest its
+    /// own, into `out[i]` (which holds the point's rough value `t0`, kept where no candidate is
+    /// finite). The operations of [`TableRows::nearest_row`], in its order: the same bits.
+    fn nearest_fine(
+        candidates: &[[[f32; 4]; 5]],
+        guess: &[u32],
+        z: &[f32],
+        inv_d: &[f32],
+        has_along: bool,
+        out: &mut [f32],
+    ) -> ();
+    body: nearest_fine_body, avx2: "avx2" if std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// The body of [`nearest_fine`], inlined into each instruction-set variant.
+#[inline(always)]
+fn nearest_fine_body(
+    candidates: &[[[f32; 4]; 5]],
+    guess: &[u32],
+    z: &[f32],
+    inv_d: &[f32],
+    has_along: bool,
+    out: &mut [f32],
+) {
+    let m = out.len();
+    let (guess, z, inv_d) = (&guess[..m], &z[..m], &inv_d[..m]);
+    if has_along {
+        for i in 0..m {
+            let (z, inv_d, t0) = (z[i], inv_d[i], out[i]);
+            let inv_d2 = inv_d * inv_d;
+            let (mut best_e, mut best_f) = (f32::INFINITY, t0);
+            for [v_r, half_hh, tan_r, a_r] in candidates[guess[i] as usize] {
+                let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2) / (1.0 - a_r * inv_d).max(1e-3);
+                let e = (f - tan_r).abs();
+                (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
+            }
+            out[i] = best_f;
+        }
+    } else {
+        for i in 0..m {
+            let (z, inv_d, t0) = (z[i], inv_d[i], out[i]);
+            let inv_d2 = inv_d * inv_d;
+            let (mut best_e, mut best_f) = (f32::INFINITY, t0);
+            for [v_r, half_hh, tan_r, _] in candidates[guess[i] as usize] {
+                let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2);
+                let e = (f - tan_r).abs();
+                (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
+            }
+            out[i] = best_f;
+        }
+    }
+}
+
 impl TableRows {
     /// Number of rows.
     pub fn len(&self) -> usize {
@@ -396,29 +452,12 @@ impl TableRows {
                 })
             })
             .collect();
-        // Pass 2: the nearest row's fine value (a loop of its own for origins out along the beam,
-        // so that the others keep their one multiply per candidate).
-        let has_along = self.has_along;
-        for (i, (o, &inv_d)) in out.iter_mut().zip(&inv).enumerate() {
-            let (z, t0) = (z(i), *o);
-            let guess = self.guess.rows_below(tan, t0).min(n - 1);
-            let inv_d2 = inv_d * inv_d;
-            let (mut best_e, mut best_f) = (f32::INFINITY, t0);
-            if has_along {
-                for [v_r, half_hh, tan_r, a_r] in candidates[guess] {
-                    let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2) / (1.0 - a_r * inv_d).max(1e-3);
-                    let e = (f - tan_r).abs();
-                    (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
-                }
-            } else {
-                for [v_r, half_hh, tan_r, _] in candidates[guess] {
-                    let f = (z - v_r) * inv_d * (1.0 + half_hh * inv_d2);
-                    let e = (f - tan_r).abs();
-                    (best_e, best_f) = if e < best_e { (e, f) } else { (best_e, best_f) };
-                }
-            }
-            *o = best_f;
-        }
+        // Pass 2: each point's first guess (a short search per point, branches), then the nearest
+        // of its five candidate rows' fine values in a loop of its own that the compiler
+        // vectorises (gathers of the candidates).
+        let guess: Vec<u32> = out.iter().map(|&t0| self.guess.rows_below(tan, t0).min(n - 1) as u32).collect();
+        let zs: Vec<f32> = (0..out.len()).map(z).collect();
+        nearest_fine(&candidates, &guess, &zs, &inv, self.has_along, out);
     }
 
     /// Azimuth of the beam of row `row` that hit `p` (sensor frame): the point's azimuth less the
