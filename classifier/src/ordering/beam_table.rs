@@ -359,6 +359,60 @@ fn nearest_fine_body(
     }
 }
 
+crate::cpu::dispatch_by_isa! {
+    /// [`RowGuess::rows_below`] of every `t[i]`, capped at the last row, into `out[i]`: one step
+    /// down and one up from the bin's count in a loop the compiler vectorises (almost every bin
+    /// holds at most one row edge), then the points whose count is not yet exact (both conditions
+    /// of the partition point checked) searched one at a time. The same values.
+    fn rows_below_all(guess: &RowGuess, tan_padded: &[f32], t: &[f32], out: &mut [u32]) -> ();
+    body: rows_below_all_body, avx2: "avx2" if std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// The body of [`rows_below_all`]; `tan_padded` is the table's `tan(elevation)` with `+inf` after
+/// the last row.
+#[inline(always)]
+fn rows_below_all_body(guess: &RowGuess, tan_padded: &[f32], t: &[f32], out: &mut [u32]) {
+    let n = tan_padded.len() - 1;
+    let last_bin = guess.below.len() - 1;
+    let out = &mut out[..t.len()];
+    let mut inexact = 0usize;
+    for (o, &t) in out.iter_mut().zip(t) {
+        let bin = (((t - guess.lo) * guess.scale) as usize).min(last_bin);
+        let mut g = usize::from(guess.below[bin]).min(n);
+        // One step down (`!(a < t)`: NaN steps too, as the search's comparison does).
+        let below_tan = tan_padded[g.saturating_sub(1)];
+        let down = g > 0 && !(below_tan < t);
+        g -= usize::from(down);
+        // One step up (`tan_padded[n]` is `+inf`: never below `t`).
+        g += usize::from(tan_padded[g] < t);
+        g = g.min(n);
+        let exact = (g == 0 || tan_padded[g.saturating_sub(1)] < t) && !(tan_padded[g] < t);
+        inexact += usize::from(!exact);
+        *o = if exact { g as u32 } else { u32::MAX };
+    }
+    if inexact > 0 {
+        let tan = &tan_padded[..n];
+        for (o, &t) in out.iter_mut().zip(t) {
+            if *o == u32::MAX {
+                *o = guess.rows_below(tan, t) as u32;
+            }
+        }
+    }
+    for o in out.iter_mut() {
+        *o = (*o).min(n as u32 - 1);
+    }
+}
+
+impl RowGuess {
+    /// [`RowGuess::rows_below`] of every `t[i]`, capped at the last row of `tan`, into `out[i]`.
+    fn rows_below_all(&self, tan: &[f32], t: &[f32], out: &mut [u32]) {
+        let mut padded = Vec::with_capacity(tan.len() + 1);
+        padded.extend_from_slice(tan);
+        padded.push(f32::INFINITY);
+        rows_below_all(self, &padded, t, out);
+    }
+}
+
 impl TableRows {
     /// Number of rows.
     pub fn len(&self) -> usize {
@@ -455,7 +509,8 @@ impl TableRows {
         // Pass 2: each point's first guess (a short search per point, branches), then the nearest
         // of its five candidate rows' fine values in a loop of its own that the compiler
         // vectorises (gathers of the candidates).
-        let guess: Vec<u32> = out.iter().map(|&t0| self.guess.rows_below(tan, t0).min(n - 1) as u32).collect();
+        let mut guess = vec![0u32; out.len()];
+        self.guess.rows_below_all(tan, out, &mut guess);
         let zs: Vec<f32> = (0..out.len()).map(z).collect();
         nearest_fine(&candidates, &guess, &zs, &inv, self.has_along, out);
     }
@@ -563,6 +618,29 @@ mod tests {
                 assert_eq!(usize::from(below), tan.partition_point(|&x| x < edge), "bin {b}");
             }
         }
+    }
+
+    /// The batched first guesses equal the search one point at a time, for unevenly spaced rows
+    /// (bins holding several row edges, so the batch's one step each way is not always enough),
+    /// values exactly on row edges, outside the table, infinite and NaN.
+    #[test]
+    fn batched_row_guesses_equal_the_search() {
+        let tan: Vec<f32> = [-0.4f32, -0.3999, -0.3998, -0.2, -0.19, -0.05, 0.0, 0.0001, 0.1, 0.35].to_vec();
+        let guess = RowGuess::new(&tan);
+        let mut t: Vec<f32> = (0..20_000).map(|k| -0.5 + k as f32 * 1e-4 * 0.47).collect();
+        t.extend(tan.iter().copied());
+        t.extend(tan.iter().map(|x| x.next_up()));
+        t.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1e30, 1e30]);
+        let mut got = vec![0u32; t.len()];
+        guess.rows_below_all(&tan, &t, &mut got);
+        let mut steps_beyond_one = 0;
+        for (i, &x) in t.iter().enumerate() {
+            let want = guess.rows_below(&tan, x).min(tan.len() - 1);
+            assert_eq!(got[i] as usize, want, "t = {x}");
+            let bin = (((x - guess.lo) * guess.scale) as usize).min(guess.below.len() - 1);
+            steps_beyond_one += usize::from(guess.rows_below(&tan, x).abs_diff(usize::from(guess.below[bin])) > 1);
+        }
+        assert!(steps_beyond_one > 0, "no value needed the one-at-a-time search: the test would not see it fail");
     }
 
     /// The batch of fine elevations is bit for bit [`TableRows::nearest_row`]'s, with origin offsets
