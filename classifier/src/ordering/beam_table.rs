@@ -370,6 +370,8 @@ crate::cpu::dispatch_by_isa! {
 
 /// The body of [`rows_below_all`]; `tan_padded` is the table's `tan(elevation)` with `+inf` after
 /// the last row.
+// `!(a < t)` as the search compares: NaN counts no row below.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 #[inline(always)]
 fn rows_below_all_body(guess: &RowGuess, tan_padded: &[f32], t: &[f32], out: &mut [u32]) {
     let n = tan_padded.len() - 1;
