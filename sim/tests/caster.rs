@@ -298,6 +298,53 @@ fn bvh_hits_equal_brute_force_bit_for_bit() {
     }
 }
 
+/// Small meshes, where the root is a leaf (one triangle: obvhs does not collapse trees this small)
+/// or has few children: every layout and fan size gives the brute-force loop's hits, bit for bit.
+#[test]
+fn small_meshes_hit_as_the_brute_force_loop() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    for count in [1usize, 2, 3, 5, 8, 9, 12, 17, 40, 100] {
+        let mut mesh = SceneMesh::new();
+        for _ in 0..count {
+            let c = Vec3::new(rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0), rng.random_range(-1.0..1.0));
+            let half = Vec3::splat(rng.random_range(0.3..2.0));
+            mesh.push_oriented_box(
+                glam::Affine3A::from_translation(c),
+                -half,
+                half,
+                Surface::object(SemanticClass::CAR, 1),
+            );
+        }
+        // Boxes have 12 triangles; keep the first `count`.
+        let mut small = SceneMesh::new();
+        for i in 0..count {
+            let corners = mesh.triangle(i).map(|p| small.push_vertex(p));
+            small.push_triangle(corners, Surface::object(SemanticClass::CAR, 1));
+        }
+        let mut rays = lidar_rays(&[Vec3::new(0.2, 0.1, 0.5)], 8, 16, f32::INFINITY, 0.0);
+        rays.extend(random_rays(count as u64, 500).into_iter().map(|r| Ray { origin: r.origin * 0.15, ..r }));
+        // Aimed at each triangle's centre, and at its corners (shared with its box's neighbours).
+        for i in 0..count {
+            let [a, b, c] = small.triangle(i);
+            for target in [(a + b + c) / 3.0, a, (a + b) * 0.5] {
+                let origin = Vec3::new(rng.random_range(-9.0..9.0), rng.random_range(-9.0..9.0), 5.0);
+                rays.push(Ray { origin, dir: (target - origin).normalize(), t_max: f32::INFINITY });
+            }
+        }
+        let expected: Vec<Option<(u32, u32)>> =
+            rays.iter().map(|r| brute_force(&small, r).map(|h| (h.t.to_bits(), h.triangle))).collect();
+        assert!(expected.iter().any(Option::is_some), "{count} triangles: no ray hits");
+        for layout in [BvhLayout::Eight, BvhLayout::Four] {
+            for packet_rays in [0, 16] {
+                let bvh = BvhCaster::with_options(&small, BvhOptions { layout, packet_rays, ..BvhOptions::default() });
+                let got: Vec<_> =
+                    bvh.cast_all(&rays).into_iter().map(|h| h.map(|h| (h.t.to_bits(), h.triangle))).collect();
+                assert_eq!(got, expected, "{count} triangles, {layout:?}, packet_rays {packet_rays}");
+            }
+        }
+    }
+}
+
 #[test]
 fn cast_all_is_identical_on_one_and_two_threads() {
     let mesh = random_scene(21);
