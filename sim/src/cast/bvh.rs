@@ -48,8 +48,8 @@ pub enum BvhLayout {
     /// (structure-of-arrays slab tests of four children at once; see `wide.rs`).
     Four,
     /// 8-wide BVH collapsed the same way, with the same traversal over eight children at once (one
-    /// 256-bit operation per plane with AVX2). The fastest: measured 1.3x [`BvhLayout::Four`] on
-    /// the fixture's fans, 1.25x on random rays (docs/benchmarks.md).
+    /// 256-bit operation per plane with AVX2). The fastest: measured 1.2x [`BvhLayout::Four`] on
+    /// the fixture's fans and on random rays (docs/benchmarks.md).
     #[default]
     Eight,
 }
@@ -68,7 +68,7 @@ pub struct BvhOptions {
     /// tests, see `wide.rs`);
     /// other groups one ray at a time.
     pub packet_rays: usize,
-    /// Largest number of triangles per leaf (binary: 1..=255, wide: 1..=3).
+    /// Largest number of triangles per leaf (binary, 4- and 8-wide: 1..=255; obvhs's wide: 1..=3).
     pub max_prims_per_leaf: u32,
     /// Fraction of nodes considered for reinsertion after the PLOC build (0 = none).
     pub reinsertion_ratio: f32,
@@ -161,19 +161,17 @@ impl BvhCaster {
                 let idx = std::mem::take(&mut cw.primitive_indices);
                 (Tree::Wide(cw), idx)
             }
-            BvhLayout::Four => {
+            BvhLayout::Four | BvhLayout::Eight => {
                 collapse(&mut bvh2, options.max_prims_per_leaf.clamp(1, 255), 3.0);
-                let mut w = Wide::<4>::from_bvh2(&bvh2, |i| mesh.triangle(i as usize));
-                let tris = std::mem::take(&mut w.tris);
-                let order = w.order_to_triangle.clone(); // Also kept in the tree: its tie-break reads it.
-                return Self { tree: Tree::Four(w), tris, order_to_triangle: order, options, pad_m };
-            }
-            BvhLayout::Eight => {
-                collapse(&mut bvh2, options.max_prims_per_leaf.clamp(1, 255), 3.0);
-                let mut w = Wide::<8>::from_bvh2(&bvh2, |i| mesh.triangle(i as usize));
-                let tris = std::mem::take(&mut w.tris);
-                let order = w.order_to_triangle.clone();
-                return Self { tree: Tree::Eight(w), tris, order_to_triangle: order, options, pad_m };
+                let tri_of = |i: u32| mesh.triangle(i as usize);
+                let (tree, tris, order) = if options.layout == BvhLayout::Four {
+                    let (w, tris, order) = Wide::<4>::from_bvh2(&bvh2, tri_of).into_parts();
+                    (Tree::Four(w), tris, order)
+                } else {
+                    let (w, tris, order) = Wide::<8>::from_bvh2(&bvh2, tri_of).into_parts();
+                    (Tree::Eight(w), tris, order)
+                };
+                return Self { tree, tris, order_to_triangle: order, options, pad_m };
             }
         };
         let tris = indices.iter().map(|&i| mesh.triangle(i as usize)).collect();

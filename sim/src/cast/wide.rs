@@ -88,6 +88,14 @@ impl<const W: usize> Wide<W> {
         w
     }
 
+    /// The tree without its triangles, the triangles (layout order) and the layout order's mesh
+    /// indices (also kept in the tree: its tie-break reads them).
+    pub(super) fn into_parts(mut self) -> (Self, Vec<[Vec3; 3]>, Vec<u32>) {
+        let tris = std::mem::take(&mut self.tris);
+        let order = self.order_to_triangle.clone();
+        (self, tris, order)
+    }
+
     /// Appends the triangles of the binary leaf `node` and their packs; returns the first pack.
     fn emit_leaf(&mut self, bvh2: &Bvh2, node: usize, tri_of: &impl Fn(u32) -> [Vec3; 3]) -> u32 {
         let n = &bvh2.nodes[node];
