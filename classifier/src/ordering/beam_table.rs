@@ -480,15 +480,14 @@ impl TableRows {
     ) {
         let (n, tan, mean_v) = (self.len(), &self.tan_elevation[..], self.mean_vertical_m);
         let (h, v) = (&self.horizontal_m[..n], &self.vertical_m[..n]);
-        let z = |i: usize| valid.map_or(points[i], |valid| points[valid[i] as usize]).xyz().z;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = z(i);
-        }
+        // The points' heights, gathered once (both passes read them).
+        let z: Vec<f32> =
+            (0..out.len()).map(|i| valid.map_or(points[i], |valid| points[valid[i] as usize]).xyz().z).collect();
         // Pass 1: `1 / d` per point into `inv`, `t0` into `out` (vectorizes).
         let mut inv = vec![0f32; out.len()];
-        for ((o, i), &d) in out.iter_mut().zip(inv.iter_mut()).zip(dist) {
+        for (((o, i), &d), &z) in out.iter_mut().zip(inv.iter_mut()).zip(dist).zip(&z) {
             *i = 1.0 / d.max(1e-6);
-            *o = (*o - mean_v) * *i;
+            *o = (z - mean_v) * *i;
         }
         if self.has_along {
             for (o, &i) in out.iter_mut().zip(&inv) {
@@ -508,13 +507,11 @@ impl TableRows {
                 })
             })
             .collect();
-        // Pass 2: each point's first guess (a short search per point, branches), then the nearest
-        // of its five candidate rows' fine values in a loop of its own that the compiler
-        // vectorises (gathers of the candidates).
+        // Pass 2: every point's first guess, then the nearest of its five candidate rows' fine
+        // values, each a loop of its own that the compiler vectorises.
         let mut guess = vec![0u32; out.len()];
         self.guess.rows_below_all(tan, out, &mut guess);
-        let zs: Vec<f32> = (0..out.len()).map(z).collect();
-        nearest_fine(&candidates, &guess, &zs, &inv, self.has_along, out);
+        nearest_fine(&candidates, &guess, &z, &inv, self.has_along, out);
     }
 
     /// Azimuth of the beam of row `row` that hit `p` (sensor frame): the point's azimuth less the
