@@ -1,6 +1,8 @@
 //! Rings recovered without a sensor given, on hand-made clouds of a sensor no known table matches
 //! (20 beams, 1.58 deg apart): ring-major and firing order, single and dual returns, give every
-//! point its true cell and name no sensor; a shuffled cloud is refused with a typed error.
+//! point its true cell and name no sensor; a shuffled cloud is refused with a typed error. With the
+//! sensor's calibration file (which gives no column count), the same clouds, a shuffled one and a
+//! ring field in laser-id order take its lasers and the columns the data shows.
 
 use classifier::ClassifyError;
 use classifier::ordering::{
@@ -159,4 +161,81 @@ fn motion_compensated_no_returns_are_no_returns_and_a_ring_less_copy_reads_as_it
     }
     assert_eq!(ring_less.sensor.as_ref().unwrap().order, RecoveredOrder::ImageColumns);
     assert_eq!(with_rings.cell_of_point, ring_less.cell_of_point);
+}
+
+/// The 20 beams as Hesai's angle-correction CSV: laser ids from the top beam down, then every
+/// other one swapped (ids not in elevation order, as Hesai's are not), no column count.
+fn calibration_csv(dir: &std::path::Path) -> (std::path::PathBuf, Vec<usize>) {
+    // Laser id k (0-based) -> beam row.
+    let mut row_of_laser: Vec<usize> = (0..BEAMS).rev().collect();
+    for pair in row_of_laser.chunks_mut(4) {
+        pair.swap(0, 1);
+    }
+    let mut text = String::from("Laser id,Elevation,Azimuth\n");
+    for (k, &row) in row_of_laser.iter().enumerate() {
+        let el = -25.0 + 30.0 * row as f64 / (BEAMS - 1) as f64;
+        text.push_str(&format!("{},{el},0\n", k + 1));
+    }
+    let path = dir.join("angle_correction.csv");
+    std::fs::write(&path, text).unwrap();
+    (path, row_of_laser)
+}
+
+#[test]
+fn a_calibration_without_columns_takes_the_order_echoes_and_columns_from_the_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, row_of_laser) = calibration_csv(dir.path());
+    let setup = SensorSetup::new(None, Some(&csv)).unwrap();
+    let run = |points: &[Vec3], rings: Option<&[u16]>| {
+        let (mut cloud, mut report) = (CloudBuffer::default(), OrderingReport::default());
+        let attributes = PointAttributes { rings, ..PointAttributes::default() };
+        setup.order_flat(points, &attributes, &mut cloud, &mut report).map(|()| (cloud.into_cloud(), report))
+    };
+    // Ring-major, firing order with second echoes, shuffled: the grid the sensor has (not a
+    // default column count), every point in its true cell.
+    let mut fired = Vec::new();
+    for col in 0..COLS {
+        fired.extend((0..BEAMS).rev().map(|r| (r, col, 0.0)));
+        fired.extend((0..BEAMS).rev().filter(|r| (r + col) % 3 == 0).map(|r| (r, col, 2.0)));
+    }
+    let ring_cells: Vec<(usize, usize, f32)> = ring_major().into_iter().map(|(r, c)| (r, c, 0.0)).collect();
+    let n = ring_cells.len();
+    let shuffled: Vec<(usize, usize, f32)> = (0..n).map(|k| ring_cells[(k * 7919 + 13) % n]).collect();
+    for (kind, echoes, cells) in [
+        (RecoveredOrder::RingMajor, 1, ring_cells),
+        (RecoveredOrder::Firing, 2, fired),
+        (RecoveredOrder::Elevations, 1, shuffled),
+    ] {
+        let points: Vec<Vec3> = cells.iter().map(|&(r, c, f)| point(r, c, f)).collect();
+        let (cloud, report) = run(&points, None).unwrap();
+        let sensor = report.sensor.clone().expect("recovered");
+        assert!(sensor.calibrated, "{}", report.summary());
+        assert_eq!((sensor.order, sensor.echoes, sensor.rows, sensor.columns), (kind, echoes, BEAMS, COLS));
+        assert_eq!((cloud.rows, cloud.cols), (BEAMS, COLS));
+        assert!(
+            report.summary().contains("from the calibration file: 20 lasers x 1000 columns"),
+            "{}",
+            report.summary()
+        );
+        for (k, &(r, c, _)) in cells.iter().enumerate() {
+            assert_eq!(report.cell_of_point[k], Some((r * COLS + c) as u32), "{kind:?} point {k}");
+        }
+    }
+    // A ring field of laser ids (0-based, the calibration's order): each ring takes its laser's row.
+    let laser_of_row: Vec<u16> =
+        (0..BEAMS).map(|row| row_of_laser.iter().position(|&r| r == row).unwrap() as u16).collect();
+    let cells = firing();
+    let points: Vec<Vec3> = cells.iter().map(|&(r, c)| point(r, c, 0.0)).collect();
+    let rings: Vec<u16> = cells.iter().map(|&(r, _)| laser_of_row[r]).collect();
+    let (_, report) = run(&points, Some(&rings)).unwrap();
+    let sensor = report.sensor.clone().expect("recovered");
+    assert_eq!((sensor.order, sensor.columns, sensor.calibrated), (RecoveredOrder::RingField, COLS, true));
+    for (k, &(r, c)) in cells.iter().enumerate() {
+        assert_eq!(report.cell_of_point[k], Some((r * COLS + c) as u32), "ring field point {k}");
+    }
+    // A ring beyond the calibration's lasers is refused, naming the ring.
+    let mut beyond = rings.clone();
+    beyond[5] = BEAMS as u16;
+    let e = run(&points, Some(&beyond)).unwrap_err().to_string();
+    assert!(e.contains("ring 20 holds points, out of range 0 ..= 19 (the calibration file's lasers)"), "{e}");
 }

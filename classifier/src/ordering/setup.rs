@@ -56,6 +56,11 @@ pub struct SensorSetup {
     /// ring field where it has one), `table` (the HDL-64E nominal one) serving only to detect
     /// organized KITTI-layout frames of 64 rows.
     pub recover: bool,
+    /// `table` holds the lasers of a calibration file that gives no column count (Velodyne's
+    /// YAML, Hesai's angle-correction CSV), and no rig was given: flat clouds are ordered on its
+    /// lasers with the point order, the echoes and the columns recovered from the data
+    /// ([`super::recover`]), as for a sensor not given, never on a default column count.
+    pub columns_from_data: bool,
 }
 
 impl Default for SensorSetup {
@@ -68,6 +73,7 @@ impl Default for SensorSetup {
             vehicle_from_sensor: Affine3A::IDENTITY,
             calibrated_lasers: None,
             recover: true,
+            columns_from_data: false,
         }
     }
 }
@@ -101,6 +107,7 @@ impl SensorSetup {
                     vehicle_from_sensor: s.mount.vehicle_from_sensor(),
                     calibrated_lasers: None,
                     recover: false,
+                    columns_from_data: false,
                 }
             }
             None => Self::default(),
@@ -108,6 +115,9 @@ impl SensorSetup {
         if let Some(file) = calibration {
             let expected = rig.map(|_| setup.table.elevations_rad.len());
             let cal = Calibration::load(file, expected).map_err(|e| ClassifyError::Ordering(e.to_string()))?;
+            // Columns: the file's, else the rig's, else recovered from each cloud's data (the
+            // placeholder count here orders nothing).
+            setup.columns_from_data = cal.columns.is_none() && rig.is_none();
             let cols = cal.columns.unwrap_or(if rig.is_some() { setup.table.cols } else { KITTI_COLUMNS });
             setup.calibrated_lasers = Some(cal.lasers.len());
             // The calibration gives the lasers; a rig given beside it, the sensor's minimum range.
@@ -129,12 +139,12 @@ impl SensorSetup {
         cloud: &mut CloudBuffer,
         report: &mut OrderingReport,
     ) -> Result<()> {
-        if self.recover {
+        if self.recover || self.columns_from_data {
+            let given = self.columns_from_data.then_some(&self.table);
+            let to = self.vehicle_from_sensor;
             return match attributes.rings {
-                None => super::recover::order_recovered(points, attributes, self.vehicle_from_sensor, cloud, report),
-                Some(_) => {
-                    super::recover::order_ring_field(points, attributes, self.vehicle_from_sensor, cloud, report)
-                }
+                None => super::recover::order_recovered(points, attributes, given, to, cloud, report),
+                Some(_) => super::recover::order_ring_field(points, attributes, given, to, cloud, report),
             };
         }
         order_cloud_into(
@@ -449,8 +459,13 @@ mod tests {
             (0..beams).map(|r| (-15.0 + 30.0 * r as f32 / (beams - 1) as f32).to_radians()).collect(),
             cols,
         );
-        let setup =
-            SensorSetup { table, vehicle_from_sensor: Affine3A::IDENTITY, calibrated_lasers: None, recover: false };
+        let setup = SensorSetup {
+            table,
+            vehicle_from_sensor: Affine3A::IDENTITY,
+            calibrated_lasers: None,
+            recover: false,
+            columns_from_data: false,
+        };
         for column_major in [false, true] {
             let rec = image(beams, cols, column_major);
             let (mut cloud, mut report) = (CloudBuffer::default(), OrderingReport::default());

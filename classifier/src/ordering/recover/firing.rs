@@ -9,12 +9,12 @@
 
 use std::f32::consts::TAU;
 
-use super::matching::{match_points, row_of};
+use super::matching::{fit_rows, match_points, row_of};
 use super::{
-    DUAL_FRACTION, RecoveredOrder, RecoveredSensor, Recovery, cell_in, columns_from_steps, median, named_table,
-    unnamed_table, wrap_pi,
+    DUAL_FRACTION, RecoveredOrder, RecoveredSensor, Recovery, cell_in, columns_from_steps, given_table, median,
+    named_table, unnamed_table, wrap_pi,
 };
-use crate::ordering::beam_table::BeamTable;
+use crate::ordering::beam_table::{BeamTable, TableRows};
 use crate::ordering::{InputPoint, PathChoice};
 
 /// Fraction of successive points that must lie within [`CLOSE_STEP_DEG`] in azimuth.
@@ -37,6 +37,7 @@ pub(crate) fn recover_firing<P: InputPoint>(
     points: &[P],
     usable: Option<&[u32]>,
     az: &[f32],
+    given: Option<&BeamTable>,
 ) -> Result<Recovery, String> {
     let n = az.len();
     let index = |i: usize| usable.map_or(i as u32, |u| u[i]);
@@ -56,21 +57,22 @@ pub(crate) fn recover_firing<P: InputPoint>(
     }
     let stride = n.div_ceil(FIT_SAMPLES).max(1);
     let sample: Vec<u32> = (0..n).step_by(stride).map(index).collect();
-    let matched = match_points(points, &sample);
-    let (rows, matched_rows, rings, mean_error_deg) = match &matched {
-        Some(m) => (m.sensor.rows.clone(), true, m.sensor.rows.len(), Some(m.mean_error_deg)),
-        None => {
+    let matched = if given.is_some() { None } else { match_points(points, &sample) };
+    let (rows, matched_rows, rings, mean_error_deg) = match (given, &matched) {
+        (Some(g), _) => {
+            let rows = g.rows().map_err(|e| e.to_string())?;
+            let mean = fit_rows(points, &sample, &rows).2;
+            let rings = rows.len();
+            (rows, true, rings, Some(mean))
+        }
+        (None, Some(m)) => (m.sensor.rows.clone(), true, m.sensor.rows.len(), Some(m.mean_error_deg)),
+        (None, None) => {
             let tan = unnamed_elevations(points, usable, n)?;
             let rows = unnamed_table(&tan, 2).rows().map_err(|e| e.to_string())?;
             (rows, false, tan.len(), None)
         }
     };
-    // Each point's row: its nearest beam seen from the beam's origin.
-    let mut point_rows = vec![0u16; points.len()];
-    for i in 0..n {
-        let k = index(i) as usize;
-        point_rows[k] = row_of(&rows, matched_rows.then_some(&rows.along_m[..]), points[k].xyz()).0 as u16;
-    }
+    let point_rows = rows_of_points(points, usable, n, &rows, matched_rows);
     // Columns: the azimuth step between successive points of one row.
     let window = n.min(WINDOW);
     let mut last = vec![f32::NAN; rows.len()];
@@ -83,9 +85,15 @@ pub(crate) fn recover_firing<P: InputPoint>(
         last[row] = az[i];
     }
     let cols_estimate = columns_from_steps(steps).ok_or("no laser fires twice")?;
-    let (table, columns) = match &matched {
-        Some(m) => named_table(m.sensor, cols_estimate),
-        None => {
+    let mut model = matched.as_ref().map(|m| m.sensor.model);
+    let (table, columns) = match (given, &matched) {
+        (Some(g), _) => {
+            let (t, firing_times) = given_table(g, cols_estimate);
+            model = firing_times;
+            (t, cols_estimate)
+        }
+        (None, Some(m)) => named_table(m.sensor, cols_estimate),
+        (None, None) => {
             let tan = rows.tan_elevation.clone();
             (unnamed_table(&tan, cols_estimate), cols_estimate)
         }
@@ -93,19 +101,84 @@ pub(crate) fn recover_firing<P: InputPoint>(
     let second_echoes = second_echoes(points, usable, n, &table, &point_rows)?;
     Ok(Recovery {
         sensor: RecoveredSensor {
-            model: matched.map(|m| m.sensor.model),
+            model,
             rings,
             rows: table.elevations_rad.len(),
             columns,
             order: RecoveredOrder::Firing,
             echoes: if second_echoes.is_empty() { 1 } else { 2 },
             mean_error_deg,
+            calibrated: given.is_some(),
         },
         table,
         choice: PathChoice::BeamTable,
         second_echoes,
         point_rows: Some(point_rows),
     })
+}
+
+/// A cloud in no order recovery knows (shuffled, merged, thinned) whose lasers are `given` (a
+/// calibration file's table): each point's row from its elevation, seen from its beam's origin;
+/// columns from the azimuth gaps within the four fullest rows, their azimuths sorted (any order
+/// will do); second echoes as in firing order.
+pub(crate) fn any_order<P: InputPoint>(
+    points: &[P],
+    usable: Option<&[u32]>,
+    az: &[f32],
+    given: &BeamTable,
+) -> Result<Recovery, String> {
+    let n = az.len();
+    let index = |i: usize| usable.map_or(i as u32, |u| u[i]);
+    let rows = given.rows().map_err(|e| e.to_string())?;
+    let point_rows = rows_of_points(points, usable, n, &rows, true);
+    let mut by_row: Vec<Vec<f32>> = vec![Vec::new(); rows.len()];
+    for (i, &a) in az.iter().enumerate() {
+        by_row[usize::from(point_rows[index(i) as usize])].push(a);
+    }
+    by_row.sort_by_key(|a| std::cmp::Reverse(a.len()));
+    let mut gaps = Vec::new();
+    for a in by_row.iter_mut().take(4) {
+        a.sort_by(f32::total_cmp);
+        gaps.extend(a.windows(2).map(|w| w[1] - w[0]));
+    }
+    let cols = columns_from_steps(gaps).ok_or("no laser holds two points apart in azimuth")?;
+    let (table, model) = given_table(given, cols);
+    let second_echoes = second_echoes(points, usable, n, &table, &point_rows)?;
+    let stride = n.div_ceil(FIT_SAMPLES).max(1);
+    let sample: Vec<u32> = (0..n).step_by(stride).map(index).collect();
+    Ok(Recovery {
+        sensor: RecoveredSensor {
+            model,
+            rings: rows.len(),
+            rows: rows.len(),
+            columns: cols,
+            order: RecoveredOrder::Elevations,
+            echoes: if second_echoes.is_empty() { 1 } else { 2 },
+            mean_error_deg: Some(fit_rows(points, &sample, &rows).2),
+            calibrated: true,
+        },
+        table,
+        choice: PathChoice::BeamTable,
+        second_echoes,
+        point_rows: Some(point_rows),
+    })
+}
+
+/// Each usable point's row in `rows` (of `n` usable ones; the others 0): its nearest beam, seen
+/// from the beam's origin where `from_origins`.
+fn rows_of_points<P: InputPoint>(
+    points: &[P],
+    usable: Option<&[u32]>,
+    n: usize,
+    rows: &TableRows,
+    from_origins: bool,
+) -> Vec<u16> {
+    let mut point_rows = vec![0u16; points.len()];
+    for i in 0..n {
+        let k = usable.map_or(i, |u| u[i] as usize);
+        point_rows[k] = row_of(rows, from_origins.then_some(&rows.along_m[..]), points[k].xyz()).0 as u16;
+    }
+    point_rows
 }
 
 /// The points (of `n` usable ones) that fall into a cell an earlier point holds, where they are at

@@ -132,7 +132,11 @@ pub(crate) fn match_rings(medians: &[f32], dist_m: &[f32]) -> Option<Matched> {
 /// beam gap (the nearest row or a neighbour, each seen from its beam origin: up, across and along
 /// the beam), the fraction of rows that hold points, and the mean residual in degrees.
 fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> (f64, f64, f32) {
-    let rows = &sensor.rows;
+    fit_rows(points, sample, &sensor.rows)
+}
+
+/// [`fit`] of the table `rows` (its beam origins included).
+pub(crate) fn fit_rows<P: InputPoint>(points: &[P], sample: &[u32], rows: &TableRows) -> (f64, f64, f32) {
     let (n, tan) = (rows.len(), &rows.tan_elevation);
     let gap = |r: usize| row_gap(tan, r);
     let mut held = vec![false; n];

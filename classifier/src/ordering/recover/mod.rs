@@ -77,6 +77,9 @@ pub enum RecoveredOrder {
     /// A headerless file holding a whole sensor image column by column (a column is one firing:
     /// RELLIS-3D, nuScenes): each point's laser from its place in the firing.
     ImageColumns,
+    /// No order recovery knows (shuffled, merged or thinned) but the lasers given by a
+    /// calibration file: each point's laser from its elevation.
+    Elevations,
 }
 
 impl RecoveredOrder {
@@ -88,6 +91,7 @@ impl RecoveredOrder {
             RecoveredOrder::RingField => "ring-field",
             RecoveredOrder::ImageRows => "image-rows",
             RecoveredOrder::ImageColumns => "image-columns",
+            RecoveredOrder::Elevations => "elevations",
         }
     }
 }
@@ -96,7 +100,8 @@ impl RecoveredOrder {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RecoveredSensor {
     /// The known model whose table the data matched (`sim` model name), `None` for an unnamed
-    /// sensor ordered on the rings it shows.
+    /// sensor ordered on the rings it shows; with [`RecoveredSensor::calibrated`], the model
+    /// whose firing times the calibration file's lasers took (a unit of that model), if any.
     pub model: Option<&'static str>,
     /// Rings the data shows (lasers with returns).
     pub rings: usize,
@@ -110,6 +115,9 @@ pub struct RecoveredSensor {
     pub echoes: usize,
     /// Mean elevation error of the data against the matched table, degrees.
     pub mean_error_deg: Option<f32>,
+    /// The table is the sensor's own calibration file (which gives no column count): only the
+    /// point order, the echoes and the columns were recovered from the data.
+    pub calibrated: bool,
 }
 
 impl RecoveredSensor {
@@ -119,6 +127,7 @@ impl RecoveredSensor {
             RecoveredOrder::RingField => "lasers from the ring field".to_string(),
             RecoveredOrder::ImageRows => "lasers from the rows of a whole image stored row by row".to_string(),
             RecoveredOrder::ImageColumns => "lasers from the rows of a whole image stored firing by firing".to_string(),
+            RecoveredOrder::Elevations => "no point order: lasers from the elevations".to_string(),
             o => format!("{} order", o.name()),
         };
         let how = format!(
@@ -127,6 +136,16 @@ impl RecoveredSensor {
             self.columns,
             if self.echoes > 1 { ", dual returns" } else { "" }
         );
+        if self.calibrated {
+            let fit =
+                self.mean_error_deg.map_or(String::new(), |e| format!("; elevations within {e:.2} deg on average"));
+            let dual = if self.echoes > 1 { ", dual returns" } else { "" };
+            let times = self.model.map_or(String::new(), |m| format!("; firing times of {m}, whose unit it is"));
+            return format!(
+                "from the calibration file: {} lasers x {} columns ({order}{dual}; columns from the data{times}{fit})",
+                self.rows, self.columns
+            );
+        }
         match (self.model, self.mean_error_deg) {
             (Some(m), Some(e)) => format!("matched: {m} ({how}; elevations within {e:.2} deg on average)"),
             (Some(m), None) => format!("matched: {m} ({how})"),
@@ -230,6 +249,57 @@ fn unnamed_table(tan_sorted: &[f32], cols: usize) -> BeamTable {
     BeamTable::spinning(e, cols)
 }
 
+/// Largest difference, degrees, between a calibration file's laser and a known model's for the
+/// file to be read as a unit of that model (a unit's calibration differs from the nominal table
+/// by hundredths of a degree; neighbouring lasers lie 0.1 deg or more apart).
+const SAME_LASER_DEG: f32 = 0.05;
+
+/// A given table (a calibration file's lasers, which give no column count) over `cols` columns
+/// per turn: its elevations, azimuth and origin offsets kept. Where every laser is within
+/// [`SAME_LASER_DEG`] of one of a known model's (a unit of that model) and `cols` is one of the
+/// model's column counts, the lasers' firing-time column offsets come from the model: the file
+/// gives angles, not firing times, which are the model's.
+/// Returns the table and the model whose firing times it took, if any.
+fn given_table(given: &BeamTable, cols: usize) -> (BeamTable, Option<&'static str>) {
+    let step = TAU / cols as f32;
+    let mut t = given.clone();
+    (t.cols, t.azimuth_step_rad, t.azimuth_left_rad) = (cols, step, PI - 0.5 * step);
+    let (offsets, model) =
+        model_column_offsets(&t.elevations_rad, cols).map_or((Vec::new(), None), |(o, m)| (o, Some(m)));
+    t.column_offsets = offsets;
+    (t, model)
+}
+
+/// The column offsets of the known model with `cols` columns whose lasers are `elevations_rad`
+/// (each within [`SAME_LASER_DEG`] of a distinct laser of the model), in their order.
+fn model_column_offsets(elevations_rad: &[f32], cols: usize) -> Option<(Vec<f32>, &'static str)> {
+    let tolerance = SAME_LASER_DEG.to_radians();
+    known::known_sensors().iter().filter(|k| k.rows.len() == elevations_rad.len()).find_map(|k| {
+        let table = k.table(cols)?;
+        if table.column_offsets.len() != elevations_rad.len() {
+            return None;
+        }
+        let mut taken = vec![false; elevations_rad.len()];
+        let mut offsets = Vec::with_capacity(elevations_rad.len());
+        for &e in elevations_rad {
+            let (j, d) =
+                table.elevations_rad.iter().map(|&m| (m - e).abs()).enumerate().min_by(|a, b| a.1.total_cmp(&b.1))?;
+            if d > tolerance || std::mem::replace(&mut taken[j], true) {
+                return None;
+            }
+            offsets.push(table.column_offsets[j]);
+        }
+        Some((offsets, k.model))
+    })
+}
+
+/// The mean elevation error, degrees, of rings at `tan_sorted` (sorted up) and median distances
+/// `dist_sorted` against `table`'s rows, where they align.
+fn given_fit(table: &BeamTable, tan_sorted: &[f32], dist_sorted: &[f32]) -> Option<f32> {
+    let rows = table.rows().ok()?;
+    matching::align(tan_sorted, dist_sorted, &rows).map(|a| a.sum_deg / tan_sorted.len().max(1) as f32)
+}
+
 /// The table of a matched known sensor with about `cols_estimate` columns. An HDL-64E whose
 /// columns are not exactly one of its rates' (within [`EXACT_COLUMNS`]: real KITTI frames, whose
 /// head turns a little slower than 10 Hz, hold about 2,160) takes the nominal KITTI table, as
@@ -258,8 +328,9 @@ fn named_table(sensor: &known::KnownSensor, cols_estimate: usize) -> (BeamTable,
     (t, cols_estimate)
 }
 
-/// Recovers the sensor of `points` (sensor frame, file order, no ring field).
-pub(crate) fn recover<P: InputPoint>(points: &[P]) -> Result<Recovery, RecoveryError> {
+/// Recovers the sensor of `points` (sensor frame, file order, no ring field); with `given` (a
+/// calibration file's table) only the order, the echoes and the columns, on its lasers.
+pub(crate) fn recover<P: InputPoint>(points: &[P], given: Option<&BeamTable>) -> Result<Recovery, RecoveryError> {
     let usable = usable_indices(points);
     let index = |i: usize| usable.as_ref().map_or(i as u32, |u| u[i]);
     let (az, dist, tan) = polar::polar(points, usable.as_deref());
@@ -269,18 +340,36 @@ pub(crate) fn recover<P: InputPoint>(points: &[P]) -> Result<Recovery, RecoveryE
     }
     let params = UnfoldParams::default();
     let why_not_rings = match ring_starts(&az, &dist, &tan, provisional_rows(), &params) {
-        Ok((starts, _)) => return Ok(from_rings(&starts, &az, &dist, &tan, index)),
+        Ok((starts, _)) => return Ok(from_rings(&starts, &az, &dist, &tan, index, given)),
         Err(why) => why,
     };
-    firing::recover_firing(points, usable.as_deref(), &az).map_err(|why| RecoveryError::NoOrder {
-        points: n,
-        why: format!("not scan order: {why_not_rings}; not firing order: {why}"),
-    })
+    let why_not_firing = match firing::recover_firing(points, usable.as_deref(), &az, given) {
+        Ok(rec) => return Ok(rec),
+        Err(why) => why,
+    };
+    match given {
+        // The lasers are known: each point's row from its elevation, whatever the order.
+        Some(g) => firing::any_order(points, usable.as_deref(), &az, g).map_err(|why| RecoveryError::NoOrder {
+            points: n,
+            why: format!("not scan order: {why_not_rings}; not firing order: {why_not_firing}; {why}"),
+        }),
+        None => Err(RecoveryError::NoOrder {
+            points: n,
+            why: format!("not scan order: {why_not_rings}; not firing order: {why_not_firing}"),
+        }),
+    }
 }
 
 /// The recovery of a ring-major cloud whose usable points (`az`, `dist`, `tan`) unfolded into rings
 /// starting at `starts`; `index(i)` is usable point `i`'s index among all points.
-fn from_rings(starts: &[usize], az: &[f32], dist: &[f32], tan: &[f32], index: impl Fn(usize) -> u32) -> Recovery {
+fn from_rings(
+    starts: &[usize],
+    az: &[f32],
+    dist: &[f32],
+    tan: &[f32],
+    index: impl Fn(usize) -> u32,
+    given: Option<&BeamTable>,
+) -> Recovery {
     let n = az.len();
     let mut bounds = starts.to_vec();
     bounds.push(n);
@@ -328,22 +417,33 @@ fn from_rings(starts: &[usize], az: &[f32], dist: &[f32], tan: &[f32], index: im
         .flat_map(|&r| az[bounds[r]..bounds[r + 1]].windows(2).map(|w| wrap_pi(w[1] - w[0]).abs()))
         .collect();
     let cols_estimate = columns_from_steps(steps).unwrap_or(largest.max(2));
-    let matched = matching::match_rings(&tan_sorted, &dist_sorted);
-    let (table, columns) = match &matched {
-        Some(m) => named_table(m.sensor, cols_estimate),
-        None => (unnamed_table(&tan_sorted, cols_estimate), cols_estimate),
+    let matched = if given.is_some() { None } else { matching::match_rings(&tan_sorted, &dist_sorted) };
+    let mut model = matched.as_ref().map(|m| m.sensor.model);
+    let (table, columns) = match (given, &matched) {
+        (Some(g), _) => {
+            let (t, firing_times) = given_table(g, cols_estimate);
+            model = firing_times;
+            (t, cols_estimate)
+        }
+        (None, Some(m)) => named_table(m.sensor, cols_estimate),
+        (None, None) => (unnamed_table(&tan_sorted, cols_estimate), cols_estimate),
+    };
+    let mean_error_deg = match &matched {
+        Some(m) => Some(m.mean_error_deg),
+        None => given.and_then(|_| given_fit(&table, &tan_sorted, &dist_sorted)),
     };
     let second_echoes: Vec<u32> =
         (0..medians.len()).filter(|&r| run_of_ring[r] > 0).flat_map(|r| bounds[r]..bounds[r + 1]).map(&index).collect();
     Recovery {
         sensor: RecoveredSensor {
-            model: matched.map(|m| m.sensor.model),
+            model,
             rings: tan_sorted.len(),
             rows: table.elevations_rad.len(),
             columns,
             order: RecoveredOrder::RingMajor,
             echoes: planes.min(2),
-            mean_error_deg: matched.map(|m| m.mean_error_deg),
+            mean_error_deg,
+            calibrated: given.is_some(),
         },
         table,
         choice: PathChoice::Auto,
@@ -366,17 +466,19 @@ pub(crate) fn cell_in(rows: &TableRows, row: usize, p: glam::Vec3) -> u32 {
     (row * rows.cols + col) as u32
 }
 
-/// Orders `points` (sensor frame, no ring field) on the sensor recovered from them, into `cloud`
-/// and `report` (`report.sensor` says what was recovered); refused where no order can be
+/// Orders `points` (sensor frame, no ring field) on the sensor recovered from them (with `given`,
+/// a calibration file's table: on its lasers, the order, echoes and columns recovered), into
+/// `cloud` and `report` (`report.sensor` says what was recovered); refused where no order can be
 /// recovered.
 pub(crate) fn order_recovered<P: InputPoint>(
     points: &[P],
     attributes: &PointAttributes<'_>,
+    given: Option<&BeamTable>,
     vehicle_from_sensor: Affine3A,
     cloud: &mut CloudBuffer,
     report: &mut OrderingReport,
 ) -> Result<()> {
-    let rec = recover(points)?;
+    let rec = recover(points, given)?;
     let params = UnfoldParams::default();
     let rings = rec.point_rows.as_deref();
     if rec.second_echoes.is_empty() {
@@ -435,11 +537,13 @@ pub(crate) fn order_recovered<P: InputPoint>(
 }
 
 /// Orders `points` (sensor frame) that carry a ring field (`attributes.rings`) on the table their
-/// rings show ([`ring_field`]), into `cloud` and `report` (`report.sensor` says what was found);
-/// refused where the rings cannot give a table.
+/// rings show ([`ring_field`]; with `given`, a calibration file's table: on its lasers, the
+/// columns recovered), into `cloud` and `report` (`report.sensor` says what was found); refused
+/// where the rings cannot give a table.
 pub(crate) fn order_ring_field<P: InputPoint>(
     points: &[P],
     attributes: &PointAttributes<'_>,
+    given: Option<&BeamTable>,
     vehicle_from_sensor: Affine3A,
     cloud: &mut CloudBuffer,
     report: &mut OrderingReport,
@@ -448,7 +552,7 @@ pub(crate) fn order_ring_field<P: InputPoint>(
     if rings.len() != points.len() {
         return Err(crate::error::ClassifyError::Ordering("rings and points differ in length".into()));
     }
-    let rec = ring_field::recover_ring_field(points, rings)?;
+    let rec = ring_field::recover_ring_field(points, rings, given)?;
     let attributes = PointAttributes { rings: Some(&rec.point_rows), ..*attributes };
     let params = UnfoldParams::default();
     order_cloud_into(points, &attributes, &rec.table, vehicle_from_sensor, PathChoice::Auto, &params, cloud, report)?;

@@ -12,7 +12,7 @@ use std::f32::consts::TAU;
 use super::super::InputPoint;
 use super::super::beam_table::BeamTable;
 use super::super::unfold::sampled_median;
-use super::{RecoveredOrder, RecoveredSensor, RecoveryError, matching, named_table, unnamed_table};
+use super::{RecoveredOrder, RecoveredSensor, RecoveryError, given_table, matching, named_table, unnamed_table};
 
 /// Largest ring value a ring field may hold without a sensor given: no spinning sensor has more
 /// than 256 lasers (dual returns of 128 lasers share their laser's ring).
@@ -30,7 +30,13 @@ pub(crate) struct RingFieldTable {
 }
 
 /// The table of `points` (sensor frame) whose lasers are `rings` (one value per point).
-pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> Result<RingFieldTable, RecoveryError> {
+/// With `given` (a calibration file's table), the rings are aligned with its lasers and only the
+/// columns come from the data.
+pub(crate) fn recover_ring_field<P: InputPoint>(
+    points: &[P],
+    rings: &[u16],
+    given: Option<&BeamTable>,
+) -> Result<RingFieldTable, RecoveryError> {
     let usable = |p: glam::Vec3| p.is_finite() && p != glam::Vec3::ZERO;
     // Points per ring value (counting sort): tan(elevation), horizontal distance, azimuth.
     let mut counts = vec![0usize; usize::from(MAX_RING_VALUE) + 2];
@@ -91,11 +97,11 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     lasers.sort_by(|a, b| a.1.total_cmp(&b.1));
     let tan_sorted: Vec<f32> = lasers.iter().map(|l| l.1).collect();
     let dist_sorted: Vec<f32> = lasers.iter().map(|l| l.2).collect();
-    let matched = matching::match_rings(&tan_sorted, &dist_sorted);
+    let matched = if given.is_some() { None } else { matching::match_rings(&tan_sorted, &dist_sorted) };
     // Columns: the median azimuth gap within the four fullest rings, their azimuths sorted, over
     // the points at or beyond a matched sensor's minimum range (nearer ones are no-returns:
     // nuScenes' motion-compensated ones pile up at one azimuth and would shorten the median gap).
-    let min_range_m = matched.as_ref().map_or(0.0, |m| m.sensor.min_range_m);
+    let min_range_m = matched.as_ref().map_or(given.map_or(0.0, |g| g.min_range_m), |m| m.sensor.min_range_m);
     let mut fullest = present.clone();
     fullest.sort_by_key(|&g| std::cmp::Reverse(span(g).len()));
     let mut gaps = Vec::new();
@@ -112,14 +118,41 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     } else {
         largest.max(2)
     };
-    let (table, columns, row_of_sorted) = match &matched {
-        Some(m) => {
+    let (mut given_error_deg, mut firing_times) = (None, None);
+    let (table, columns, row_of_sorted) = match (given, &matched) {
+        (Some(g), _) => {
+            let table;
+            (table, firing_times) = given_table(g, cols_estimate);
+            let rows = table.rows().map_err(|e| RecoveryError::NoOrder { points: n_usable, why: e.to_string() })?;
+            if let Some(&g) = present.last().filter(|&&g| g >= rows.len()) {
+                return Err(RecoveryError::NoOrder {
+                    points: n_usable,
+                    why: format!(
+                        "ring {g} holds points, out of range 0 ..= {} (the calibration file's lasers)",
+                        rows.len() - 1
+                    ),
+                });
+            }
+            let Some(fit) = matching::align(&tan_sorted, &dist_sorted, &rows) else {
+                return Err(RecoveryError::NoOrder {
+                    points: n_usable,
+                    why: format!(
+                        "the ring field holds {} lasers with points; the calibration file has {}",
+                        lasers.len(),
+                        rows.len()
+                    ),
+                });
+            };
+            given_error_deg = Some(fit.sum_deg / lasers.len() as f32);
+            (table, cols_estimate, Some(fit.rows))
+        }
+        (None, Some(m)) => {
             let (table, columns) = named_table(m.sensor, cols_estimate);
             let rows = table.rows().map_err(|e| RecoveryError::NoOrder { points: n_usable, why: e.to_string() })?;
             let row_of = matching::align(&tan_sorted, &dist_sorted, &rows).map(|a| a.rows);
             (table, columns, row_of)
         }
-        None => (unnamed_table(&tan_sorted, cols_estimate), cols_estimate, None),
+        (None, None) => (unnamed_table(&tan_sorted, cols_estimate), cols_estimate, None),
     };
     // Without a matched table's alignment, a ring's row is its rank in elevation.
     let row_of_sorted = row_of_sorted.unwrap_or_else(|| (0..lasers.len()).collect());
@@ -130,13 +163,14 @@ pub(crate) fn recover_ring_field<P: InputPoint>(points: &[P], rings: &[u16]) -> 
     let point_rows = rings.iter().map(|&g| row_of_ring.get(usize::from(g)).copied().unwrap_or(0)).collect();
     Ok(RingFieldTable {
         sensor: RecoveredSensor {
-            model: matched.map(|m| m.sensor.model),
+            model: matched.map(|m| m.sensor.model).or(firing_times),
             rings: lasers.len(),
             rows: table.elevations_rad.len(),
             columns,
             order: RecoveredOrder::RingField,
             echoes: 1,
-            mean_error_deg: matched.map(|m| m.mean_error_deg),
+            mean_error_deg: matched.map(|m| m.mean_error_deg).or(given_error_deg),
+            calibrated: given.is_some(),
         },
         table,
         point_rows,
@@ -172,7 +206,7 @@ mod tests {
         // Laser ids interleaved as the HDL-32E's own: even ids bottom half, odd ids top half.
         let id = |l: usize| if l < 16 { 2 * l } else { 2 * (l - 16) + 1 } as u16;
         let (pts, rings) = turn(&e, 1808, id);
-        let got = recover_ring_field(&pts, &rings).expect("recovered");
+        let got = recover_ring_field(&pts, &rings, None).expect("recovered");
         assert_eq!(got.sensor.model, Some("hdl32e"));
         assert_eq!((got.sensor.rows, got.sensor.rings), (32, 32));
         assert!((got.sensor.columns as i64 - 1808).abs() <= 10, "{}", got.sensor.columns);
@@ -187,7 +221,7 @@ mod tests {
         // 20 lasers 1.3 deg apart from -20 deg: no catalogued sensor.
         let e: Vec<f32> = (0..20).map(|l| -20.0 + 1.3 * l as f32).collect();
         let (pts, rings) = turn(&e, 1000, |l| 19 - l as u16);
-        let got = recover_ring_field(&pts, &rings).expect("recovered");
+        let got = recover_ring_field(&pts, &rings, None).expect("recovered");
         assert_eq!(got.sensor.model, None);
         assert_eq!((got.sensor.rows, got.sensor.columns), (20, 1000));
         for (k, &g) in rings.iter().enumerate() {
@@ -202,10 +236,10 @@ mod tests {
         let e: Vec<f32> = (0..16).map(|l| -15.0 + 2.0 * l as f32).collect();
         let (pts, mut rings) = turn(&e, 200, |l| l as u16);
         rings[7] = 300;
-        let err = recover_ring_field(&pts, &rings).err().expect("refused").to_string();
+        let err = recover_ring_field(&pts, &rings, None).err().expect("refused").to_string();
         assert!(err.contains("ring 300"), "{err}");
         let one = vec![3u16; pts.len()];
-        let err = recover_ring_field(&pts, &one).err().expect("refused").to_string();
+        let err = recover_ring_field(&pts, &one, None).err().expect("refused").to_string();
         assert!(err.contains("fewer than two lasers"), "{err}");
     }
 }

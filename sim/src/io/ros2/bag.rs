@@ -211,10 +211,9 @@ impl BagWriter {
         // do not depend on the machine.
         #[cfg(feature = "bag-compression")]
         let options = match compression {
-            BagCompression::Zstd => options
-                .compression_level(ZSTD_FASTEST as u32)
-                .compression_threads(0)
-                .calculate_chunk_crcs(false),
+            BagCompression::Zstd => {
+                options.compression_level(ZSTD_FASTEST as u32).compression_threads(0).calculate_chunk_crcs(false)
+            }
             BagCompression::None => options.compression_threads(0),
         };
         let writer = options.create(BufWriter::with_capacity(1 << 20, file)).map_err(|e| bag_error(dir, e))?;
