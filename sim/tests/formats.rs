@@ -219,6 +219,15 @@ fn pcd_header_that_disagrees_with_data_is_refused() {
     let path = Path::new("t.pcd");
     let m = bad_file_message(pcd::read_bytes(path, &bytes[..bytes.len() - 5]).unwrap_err(), path);
     assert!(m.contains("declares 20 points") && m.contains("holds"), "{m}");
+    // Bytes after the declared records (a tool that wrote a few more, as a real PandarQT frame
+    // has): the declared points read, the rest counted and left unread, as PCL reads the file.
+    let mut longer = bytes.clone();
+    longer.extend_from_slice(&[0xAB; 37]);
+    let frame = pcd::PcdFrame::parse(path, &longer).unwrap();
+    assert_eq!(frame.trailing_bytes(), 37);
+    let same = |b: &[u8]| pcd::encode(&pcd::read_bytes(path, b).unwrap(), false).unwrap();
+    assert_eq!(same(&longer), same(&bytes));
+    assert_eq!(pcd::PcdFrame::parse(path, &bytes).unwrap().trailing_bytes(), 0);
     let text = String::from_utf8_lossy(&pcd::encode(&cloud, true).unwrap()).replace("POINTS 20", "POINTS 21");
     let m = bad_file_message(pcd::read_bytes(path, text.as_bytes()).unwrap_err(), path);
     assert!(m.contains("POINTS 21"), "{m}");

@@ -112,5 +112,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let skipped = report.map_or(0, |r| r.skipped);
         println!("{stem}: {} points, {ground_count} ground, {skipped} bad points skipped", bytes.len());
     }
+    for w in frames.warnings() {
+        eprintln!("{w}");
+    }
     Ok(())
 }

@@ -55,6 +55,8 @@ pub struct FrameReader {
     decided: Option<(InputLayout, LayoutBasis)>,
     /// NaN points of the last unorganized PCD or message, read as no-returns.
     nan_no_returns: usize,
+    /// Bytes after the declared records of the last binary PCD file read.
+    trailing_bytes: usize,
     /// Whether the last message declared `is_dense = true`.
     declared_dense: bool,
     /// A PCD as the file holds it (ordered from here where it is not organized).
@@ -102,6 +104,12 @@ impl FrameReader {
         self.nan_no_returns
     }
 
+    /// Bytes after the records the header declares in the last binary PCD file read (left
+    /// unread, as PCL leaves them).
+    pub fn trailing_bytes(&self) -> usize {
+        self.trailing_bytes
+    }
+
     /// Whether the last message declared itself dense (`is_dense = true`; false for files).
     pub fn declared_dense(&self) -> bool {
         self.declared_dense
@@ -118,6 +126,7 @@ impl FrameReader {
     fn forget_last_frame(&mut self) {
         self.ordered = false;
         self.nan_no_returns = 0;
+        self.trailing_bytes = 0;
         self.declared_dense = false;
         self.decided = None;
         self.labelled = None;
@@ -135,12 +144,14 @@ impl FrameReader {
         self.decided = Some(InputLayout::decide(path, &[], self.choice)?);
         match by_name {
             InputLayout::Pcd => {
-                let FrameReader { bytes, file_cloud, cloud, report, ordered, nan_no_returns, .. } = self;
+                let FrameReader { bytes, file_cloud, cloud, report, ordered, nan_no_returns, trailing_bytes, .. } =
+                    self;
                 let bytes = bytes.load(path)?;
                 let frame = PcdFrame::parse(path, bytes)?;
                 let read = order_pcd(path, &frame, setup, file_cloud, cloud, report, t0)?;
                 *ordered = read.from_another_tool;
                 *nan_no_returns = read.nan_no_returns;
+                *trailing_bytes = frame.trailing_bytes();
                 Ok(read.read_ms)
             }
             layout @ (InputLayout::Ply | InputLayout::Las) => {

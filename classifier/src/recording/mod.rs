@@ -458,6 +458,13 @@ impl Frames<'_> {
                             })
                         }
                     };
+                    if read.is_ok() && self.reader.trailing_bytes() > 0 {
+                        self.warnings.push(format!(
+                            "warning: `{}`: {} bytes after the points its header declares, left unread (as PCL's reader leaves them)",
+                            file.path.display(),
+                            self.reader.trailing_bytes()
+                        ));
+                    }
                     read.map(|(ms, (layout, basis))| {
                         self.provenance = Provenance::file(file.path.clone(), layout, basis);
                         ms
@@ -491,7 +498,8 @@ impl Frames<'_> {
     }
 
     /// The warnings so far: each bag file found cut short, naming the last message read; the
-    /// messages that declare `is_dense = true` but hold NaN points (read as no-returns).
+    /// messages that declare `is_dense = true` but hold NaN points (read as no-returns); each
+    /// binary PCD file with bytes after the points its header declares (left unread).
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }

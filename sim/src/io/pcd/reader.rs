@@ -89,6 +89,7 @@ pub struct PcdFrame<'a> {
     path: &'a Path,
     h: Header,
     data: Data<'a>,
+    trailing_bytes: usize,
 }
 
 /// A PCD file's data, as [`Source`] reads it.
@@ -109,8 +110,14 @@ impl<'a> PcdFrame<'a> {
         let h = parse_header(path, bytes)?;
         let bad = |m: String| SimError::bad_file(path, m);
         let body = &bytes[h.data_start..];
+        let mut trailing_bytes = 0;
         let data = match h.data {
+            // Bytes after the declared records are left unread, as PCL's reader leaves them (a
+            // tool that wrote a few bytes more); [`PcdFrame::trailing_bytes`] says how many.
             DataKind::Binary => {
+                let need = h.points.checked_mul(h.record_bytes).unwrap_or(usize::MAX);
+                trailing_bytes = body.len().saturating_sub(need);
+                let body = &body[..body.len() - trailing_bytes];
                 check_binary_size(path, &h, body.len())?;
                 Data::Binary(body)
             }
@@ -135,7 +142,13 @@ impl<'a> PcdFrame<'a> {
                 Data::Ascii(parse_ascii(&lines, h.tokens, &needed, bad)?)
             }
         };
-        Ok(PcdFrame { path, h, data })
+        Ok(PcdFrame { path, h, data, trailing_bytes })
+    }
+
+    /// Bytes after the records the header declares in a binary file (not read; 0 for other
+    /// files).
+    pub fn trailing_bytes(&self) -> usize {
+        self.trailing_bytes
     }
 
     /// A frame of binary records laid out as `header` says, in `body` (borrowed, or owned where
@@ -147,7 +160,7 @@ impl<'a> PcdFrame<'a> {
             std::borrow::Cow::Borrowed(b) => Data::Binary(b),
             std::borrow::Cow::Owned(v) => Data::Decompressed(v),
         };
-        Ok(PcdFrame { path, h, data })
+        Ok(PcdFrame { path, h, data, trailing_bytes: 0 })
     }
 
     /// Which conventions the file follows (`zero_cells` is counted by [`PcdFrame::read_into`];
