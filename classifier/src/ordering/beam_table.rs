@@ -197,8 +197,16 @@ impl BeamTable {
         let mean_along_m = along_m.iter().sum::<f32>() / n as f32;
         let mean_vertical_m = vertical_m.iter().sum::<f32>() / n as f32;
         let tan_elevation: Vec<f32> = elevation_rad.iter().map(|e| e.tan()).collect();
+        let row_gap = (0..n)
+            .map(|r| match r {
+                0 => tan_elevation[1] - tan_elevation[0],
+                r if r == n - 1 => tan_elevation[r] - tan_elevation[r - 1],
+                r => (tan_elevation[r + 1] - tan_elevation[r]).min(tan_elevation[r] - tan_elevation[r - 1]),
+            })
+            .collect();
         Ok(TableRows {
             guess: RowGuess::new(&tan_elevation),
+            row_gap,
             tan_elevation,
             elevation_rad,
             horizontal_m,
@@ -223,6 +231,8 @@ pub struct TableRows {
     pub elevation_rad: Vec<f32>,
     /// `tan(elevation)` per row.
     pub tan_elevation: Vec<f32>,
+    /// The smaller gap of each row's `tan(elevation)` to its neighbours'.
+    pub row_gap: Vec<f32>,
     /// Horizontal origin offset per row, metres (left of the beam).
     pub horizontal_m: Vec<f32>,
     /// Vertical origin offset per row, metres.

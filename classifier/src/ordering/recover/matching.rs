@@ -131,34 +131,35 @@ pub(crate) fn match_rings(medians: &[f32], dist_m: &[f32]) -> Option<Matched> {
 /// How well `sensor`'s table fits the sampled points: the fraction within a fifth of their row's
 /// beam gap (the nearest row or a neighbour, each seen from its beam origin: up, across and along
 /// the beam), the fraction of rows that hold points, and the mean residual in degrees.
-fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> (f64, f64, f32) {
-    fit_rows(points, sample, &sensor.rows)
+/// `None` as soon as the fraction within cannot reach [`FIT_FRACTION`] any more (the sensor is
+/// not matched then, whatever the rest of the sample gives).
+fn fit<P: InputPoint>(points: &[P], sample: &[u32], sensor: &KnownSensor) -> Option<(f64, f64, f32)> {
+    fit_until(points, sample, &sensor.rows, FIT_FRACTION)
 }
 
-/// [`fit`] of the table `rows` (its beam origins included).
+/// [`fit`] of the table `rows` (its beam origins included), over the whole sample.
 pub(crate) fn fit_rows<P: InputPoint>(points: &[P], sample: &[u32], rows: &TableRows) -> (f64, f64, f32) {
+    fit_until(points, sample, rows, 0.0).unwrap_or((0.0, 0.0, f32::NAN))
+}
+
+/// [`fit_rows`], stopped (`None`) once the fraction within is sure to stay under `floor`.
+fn fit_until<P: InputPoint>(points: &[P], sample: &[u32], rows: &TableRows, floor: f64) -> Option<(f64, f64, f32)> {
     let (n, tan) = (rows.len(), &rows.tan_elevation);
-    let gap = |r: usize| row_gap(tan, r);
     let mut held = vec![false; n];
     let (mut within, mut sum_deg) = (0usize, 0f64);
-    for &k in sample {
+    let m = sample.len().max(1) as f64;
+    // Misses beyond this leave fewer than `floor * m` within.
+    let allowed = m - floor * m;
+    for (i, &k) in sample.iter().enumerate() {
         let (best_row, best, outside) = row_of(rows, Some(&rows.along_m), points[k as usize].xyz());
         held[best_row] = true;
         within += usize::from(!outside && best < 0.2);
-        sum_deg += f64::from((best * gap(best_row) / (1.0 + tan[best_row] * tan[best_row])).to_degrees());
+        sum_deg += f64::from((best * rows.row_gap[best_row] / (1.0 + tan[best_row] * tan[best_row])).to_degrees());
+        if (i + 1 - within) as f64 > allowed {
+            return None;
+        }
     }
-    let m = sample.len().max(1) as f64;
-    (within as f64 / m, held.iter().filter(|&&h| h).count() as f64 / n as f64, (sum_deg / m) as f32)
-}
-
-/// The smaller gap of row `r` to its neighbours, `tan(elevation)`.
-fn row_gap(tan: &[f32], r: usize) -> f32 {
-    let n = tan.len();
-    match r {
-        0 => tan[1] - tan[0],
-        r if r == n - 1 => tan[r] - tan[r - 1],
-        r => (tan[r + 1] - tan[r]).min(tan[r] - tan[r - 1]),
-    }
+    Some((within as f64 / m, held.iter().filter(|&&h| h).count() as f64 / n as f64, (sum_deg / m) as f32))
 }
 
 /// The row of `p` (sensor frame) in `rows`: of the nearest row ([`TableRows::nearest_row`]) and
@@ -168,12 +169,12 @@ fn row_gap(tan: &[f32], r: usize) -> f32 {
 pub(crate) fn row_of(rows: &TableRows, along_m: Option<&[f32]>, p: glam::Vec3) -> (usize, f32, bool) {
     let (n, tan) = (rows.len(), &rows.tan_elevation);
     let (row, f, outside) = rows.nearest_row(p);
-    let mut best = ((f - tan[row]).abs() / row_gap(tan, row), row);
+    let mut best = ((f - tan[row]).abs() / rows.row_gap[row], row);
     if let Some(along) = along_m {
         let d = (p.x * p.x + p.y * p.y).sqrt();
         for r in row.saturating_sub(1)..=(row + 1).min(n - 1) {
             let t = (p.z - rows.vertical_m[r]) / (d - along[r]).max(1e-3);
-            let e = (t - tan[r]).abs() / row_gap(tan, r);
+            let e = (t - tan[r]).abs() / rows.row_gap[r];
             if e < best.0 {
                 best = (e, r);
             }
@@ -186,7 +187,7 @@ pub(crate) fn row_of(rows: &TableRows, along_m: Option<&[f32]>, p: glam::Vec3) -
 pub(crate) fn match_points<P: InputPoint>(points: &[P], sample: &[u32]) -> Option<Matched> {
     let mut best: Option<(f64, usize, Matched)> = None;
     for sensor in known_sensors() {
-        let (within, held, mean) = fit(points, sample, sensor);
+        let Some((within, held, mean)) = fit(points, sample, sensor) else { continue };
         if within < FIT_FRACTION || held < 0.75 {
             continue;
         }
@@ -239,5 +240,44 @@ mod tests {
                 panic!("{} shifted matched {}", sensor.model, m.sensor.model);
             }
         }
+    }
+
+    /// The fit that stops early rejects exactly the tables whose whole-sample fraction within is
+    /// under the floor, and gives the whole-sample figures otherwise: points on each known table's
+    /// beams (20 m out, every 7th degree of azimuth, each beam seen from its origin) fitted
+    /// against every known table.
+    #[test]
+    fn a_fit_stopped_early_rejects_what_the_whole_fit_rejects() {
+        let mut accepted = 0;
+        for truth in known_sensors() {
+            let r = &truth.rows;
+            let points: Vec<glam::Vec3> = (0..r.len())
+                .flat_map(|j| {
+                    (0..52).map(move |k| {
+                        let az = (k as f32 * 7.0).to_radians();
+                        let d = 20.0;
+                        glam::Vec3::new(
+                            (d + r.along_m[j]) * az.cos(),
+                            (d + r.along_m[j]) * az.sin(),
+                            r.vertical_m[j] + d * r.tan_elevation[j],
+                        )
+                    })
+                })
+                .collect();
+            let sample: Vec<u32> = (0..points.len() as u32).collect();
+            for table in known_sensors() {
+                let whole = fit_rows(&points, &sample, &table.rows);
+                match fit(&points, &sample, table) {
+                    Some(f) => {
+                        assert!(whole.0 >= FIT_FRACTION, "{} on {}", table.model, truth.model);
+                        assert_eq!(f, whole);
+                        accepted += 1;
+                    }
+                    None => assert!(whole.0 < FIT_FRACTION, "{} on {}: {}", table.model, truth.model, whole.0),
+                }
+            }
+        }
+        // Each table accepts at least its own points; most reject the others'.
+        assert!(accepted >= known_sensors().len() && accepted < known_sensors().len().pow(2) / 2, "{accepted}");
     }
 }
