@@ -115,7 +115,7 @@ impl<'a> PcdFrame<'a> {
             // Bytes after the declared records are left unread, as PCL's reader leaves them (a
             // tool that wrote a few bytes more); [`PcdFrame::trailing_bytes`] says how many.
             DataKind::Binary => {
-                let need = h.points.checked_mul(h.record_bytes).unwrap_or(usize::MAX);
+                let need = h.points.saturating_mul(h.record_bytes);
                 trailing_bytes = body.len().saturating_sub(need);
                 let body = &body[..body.len() - trailing_bytes];
                 check_binary_size(path, &h, body.len())?;
