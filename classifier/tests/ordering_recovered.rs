@@ -211,6 +211,7 @@ fn a_calibration_without_columns_takes_the_order_echoes_and_columns_from_the_dat
         let sensor = report.sensor.clone().expect("recovered");
         assert!(sensor.calibrated, "{}", report.summary());
         assert_eq!((sensor.order, sensor.echoes, sensor.rows, sensor.columns), (kind, echoes, BEAMS, COLS));
+        assert_eq!(sensor.rings, BEAMS, "{kind:?}: every laser holds points");
         assert_eq!((cloud.rows, cloud.cols), (BEAMS, COLS));
         assert!(
             report.summary().contains("from the calibration file: 20 lasers x 1000 columns"),

@@ -62,8 +62,7 @@ pub(crate) fn recover_firing<P: InputPoint>(
         (Some(g), _) => {
             let rows = g.rows().map_err(|e| e.to_string())?;
             let mean = fit_rows(points, &sample, &rows).2;
-            let rings = rows.len();
-            (rows, true, rings, Some(mean))
+            (rows, true, 0, Some(mean))
         }
         (None, Some(m)) => (m.sensor.rows.clone(), true, m.sensor.rows.len(), Some(m.mean_error_deg)),
         (None, None) => {
@@ -73,6 +72,7 @@ pub(crate) fn recover_firing<P: InputPoint>(
         }
     };
     let point_rows = rows_of_points(points, usable, n, &rows, matched_rows);
+    let rings = if given.is_some() { rows_with_points(&point_rows, usable, n, rows.len()) } else { rings };
     // Columns: the azimuth step between successive points of one row.
     let window = n.min(WINDOW);
     let mut last = vec![f32::NAN; rows.len()];
@@ -149,7 +149,7 @@ pub(crate) fn any_order<P: InputPoint>(
     Ok(Recovery {
         sensor: RecoveredSensor {
             model,
-            rings: rows.len(),
+            rings: rows_with_points(&point_rows, usable, n, rows.len()),
             rows: rows.len(),
             columns: cols,
             order: RecoveredOrder::Elevations,
@@ -162,6 +162,15 @@ pub(crate) fn any_order<P: InputPoint>(
         second_echoes,
         point_rows: Some(point_rows),
     })
+}
+
+/// How many of the `rows` rows hold one of the `n` usable points.
+fn rows_with_points(point_rows: &[u16], usable: Option<&[u32]>, n: usize, rows: usize) -> usize {
+    let mut held = vec![false; rows];
+    for i in 0..n {
+        held[usize::from(point_rows[usable.map_or(i, |u| u[i] as usize)])] = true;
+    }
+    held.iter().filter(|&&h| h).count()
 }
 
 /// Each usable point's row in `rows` (of `n` usable ones; the others 0): its nearest beam, seen
