@@ -11,8 +11,8 @@ use std::f32::consts::TAU;
 
 use super::matching::{fit_rows, match_points, row_of};
 use super::{
-    DUAL_FRACTION, RecoveredOrder, RecoveredSensor, Recovery, cell_in, columns_from_steps, given_table, median,
-    named_table, unnamed_table, wrap_pi,
+    DUAL_FRACTION, RecoveredOrder, RecoveredSensor, Recovery, cell_in, chosen_table, columns_from_steps, given_table,
+    median, unnamed_table, wrap_pi,
 };
 use crate::ordering::beam_table::{BeamTable, TableRows};
 use crate::ordering::{InputPoint, PathChoice};
@@ -85,19 +85,7 @@ pub(crate) fn recover_firing<P: InputPoint>(
         last[row] = az[i];
     }
     let cols_estimate = columns_from_steps(steps).ok_or("no laser fires twice")?;
-    let mut model = matched.as_ref().map(|m| m.sensor.model);
-    let (table, columns) = match (given, &matched) {
-        (Some(g), _) => {
-            let (t, firing_times) = given_table(g, cols_estimate);
-            model = firing_times;
-            (t, cols_estimate)
-        }
-        (None, Some(m)) => named_table(m.sensor, cols_estimate),
-        (None, None) => {
-            let tan = rows.tan_elevation.clone();
-            (unnamed_table(&tan, cols_estimate), cols_estimate)
-        }
-    };
+    let (table, columns, model) = chosen_table(given, matched.as_ref(), &rows.tan_elevation, cols_estimate);
     let second_echoes = second_echoes(points, usable, n, &table, &point_rows)?;
     Ok(Recovery {
         sensor: RecoveredSensor {

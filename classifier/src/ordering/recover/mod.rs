@@ -300,6 +300,28 @@ fn given_fit(table: &BeamTable, tan_sorted: &[f32], dist_sorted: &[f32]) -> Opti
     matching::align(tan_sorted, dist_sorted, &rows).map(|a| a.sum_deg / tan_sorted.len().max(1) as f32)
 }
 
+/// The table to order with, its columns and the model named in the report: the `given` table over
+/// `cols_estimate` columns (named: the model whose firing times it took, if any), else the
+/// `matched` sensor's, else an unnamed sensor's of the elevations `tan_sorted`.
+fn chosen_table(
+    given: Option<&BeamTable>,
+    matched: Option<&matching::Matched>,
+    tan_sorted: &[f32],
+    cols_estimate: usize,
+) -> (BeamTable, usize, Option<&'static str>) {
+    match (given, matched) {
+        (Some(g), _) => {
+            let (t, firing_times) = given_table(g, cols_estimate);
+            (t, cols_estimate, firing_times)
+        }
+        (None, Some(m)) => {
+            let (t, cols) = named_table(m.sensor, cols_estimate);
+            (t, cols, Some(m.sensor.model))
+        }
+        (None, None) => (unnamed_table(tan_sorted, cols_estimate), cols_estimate, None),
+    }
+}
+
 /// The table of a matched known sensor with about `cols_estimate` columns. An HDL-64E whose
 /// columns are not exactly one of its rates' (within [`EXACT_COLUMNS`]: real KITTI frames, whose
 /// head turns a little slower than 10 Hz, hold about 2,160) takes the nominal KITTI table, as
@@ -418,16 +440,7 @@ fn from_rings(
         .collect();
     let cols_estimate = columns_from_steps(steps).unwrap_or(largest.max(2));
     let matched = if given.is_some() { None } else { matching::match_rings(&tan_sorted, &dist_sorted) };
-    let mut model = matched.as_ref().map(|m| m.sensor.model);
-    let (table, columns) = match (given, &matched) {
-        (Some(g), _) => {
-            let (t, firing_times) = given_table(g, cols_estimate);
-            model = firing_times;
-            (t, cols_estimate)
-        }
-        (None, Some(m)) => named_table(m.sensor, cols_estimate),
-        (None, None) => (unnamed_table(&tan_sorted, cols_estimate), cols_estimate),
-    };
+    let (table, columns, model) = chosen_table(given, matched.as_ref(), &tan_sorted, cols_estimate);
     let mean_error_deg = match &matched {
         Some(m) => Some(m.mean_error_deg),
         None => given.and_then(|_| given_fit(&table, &tan_sorted, &dist_sorted)),
