@@ -30,6 +30,18 @@ fn scan(rig: &str) -> (OrderedCloud, sim::Rig) {
     (frames.swap_remove(0).cloud, rig)
 }
 
+/// The point orders a `.bin` of `cloud` (scanned with `rig`) is written in: ring-major (our
+/// writer, KITTI) and the sensor's firing order (the drivers').
+fn both_orders(cloud: &OrderedCloud, rig: &sim::Rig) -> [(RecoveredOrder, Vec<usize>); 2] {
+    let spec = &rig.sensors[0].spec;
+    let pattern = spec.pattern();
+    let cycle_s = pattern.frame_period_s / pattern.cols as f64;
+    [
+        (RecoveredOrder::RingMajor, sim::io::kitti::scan_order(cloud)),
+        (RecoveredOrder::Firing, sim::io::kitti::firing_order(cloud, &spec.firing_ranks(cloud.rows), cycle_s)),
+    ]
+}
+
 /// What ordering a `.bin` of `cloud`'s returns in `order` (sensor frame) with `setup` gives: the
 /// report, the ordered grid's shape and the fraction of returns in their simulated cell.
 fn order_bin(
@@ -57,15 +69,8 @@ fn order_bin(
 fn every_roof_sensor_is_named_and_its_rings_and_columns_recovered_in_both_orders() {
     for rig_name in spinning_roof_rigs() {
         let (cloud, rig) = scan(rig_name);
-        let spec = &rig.sensors[0].spec;
-        let model = spec.model_name();
-        let pattern = spec.pattern();
-        let cycle_s = pattern.frame_period_s / pattern.cols as f64;
-        let orders = [
-            (RecoveredOrder::RingMajor, sim::io::kitti::scan_order(&cloud)),
-            (RecoveredOrder::Firing, sim::io::kitti::firing_order(&cloud, &spec.firing_ranks(cloud.rows), cycle_s)),
-        ];
-        for (order_kind, order) in orders {
+        let model = rig.sensors[0].spec.model_name();
+        for (order_kind, order) in both_orders(&cloud, &rig) {
             let (report, shape, right) = order_bin(&cloud, &rig, &order, &SensorSetup::default());
             let sensor = report.sensor.as_ref().unwrap_or_else(|| panic!("{rig_name}: no sensor recovered"));
             let what = format!("{rig_name} {}: {}", order_kind.name(), report.summary());
@@ -131,13 +136,7 @@ fn hesai_files_read_with_the_units_angle_correction_csv_keep_the_sensors_columns
         let setup = SensorSetup::new(None, Some(&path)).expect("calibration");
         let (cloud, rig) = scan(rig_name);
         let spec = &rig.sensors[0].spec;
-        let pattern = spec.pattern();
-        let cycle_s = pattern.frame_period_s / pattern.cols as f64;
-        let orders = [
-            (RecoveredOrder::RingMajor, sim::io::kitti::scan_order(&cloud)),
-            (RecoveredOrder::Firing, sim::io::kitti::firing_order(&cloud, &spec.firing_ranks(cloud.rows), cycle_s)),
-        ];
-        for (order_kind, order) in orders {
+        for (order_kind, order) in both_orders(&cloud, &rig) {
             let (report, shape, right) = order_bin(&cloud, &rig, &order, &setup);
             let what = format!("{rig_name} {} with its CSV: {}", order_kind.name(), report.summary());
             let sensor = report.sensor.as_ref().unwrap_or_else(|| panic!("{what}: no order recovered"));
