@@ -150,6 +150,39 @@ fn hesai_files_read_with_the_units_angle_correction_csv_keep_the_sensors_columns
     }
 }
 
+/// A rig or calibration file that is not the sensor's is refused, never ordered on: the HDL-64E's
+/// `.bin` read with the VLP-16's or the OS1-64's rig, the Pandar64's with the PandarXT-32's CSV
+/// (most points fall in a cell an earlier point holds); read with its own rig it is ordered.
+#[test]
+fn a_table_that_is_not_the_sensors_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let read = |rig_name: &str, setup: &SensorSetup| {
+        let (cloud, rig) = scan(rig_name);
+        let sensor_from_vehicle = rig.sensors[0].mount.vehicle_from_sensor().inverse();
+        let order = sim::io::kitti::scan_order(&cloud);
+        let (bin, _, _) = sim::io::kitti::encode_in_order(&cloud, &order, Some(&sensor_from_vehicle)).unwrap();
+        let pts = sim::io::kitti::points_from_bytes(std::path::Path::new("f.bin"), &bin, None).unwrap();
+        let records: Vec<[f32; 4]> = pts.points.iter().zip(&pts.intensity).map(|(p, &i)| [p.x, p.y, p.z, i]).collect();
+        let (mut out, mut report) = (CloudBuffer::default(), OrderingReport::default());
+        setup.order_kitti(&records, None, &mut out, &mut report).map(|()| report)
+    };
+    let with_rig = |name: &str| SensorSetup::new(Some(&sim::Rig::load(name).unwrap()), None).unwrap();
+    for wrong in ["vlp16-roof", "os1-64-roof"] {
+        let e = read("hdl64e-roof", &with_rig(wrong)).unwrap_err().to_string();
+        assert!(e.contains("the rig's beam table") && e.contains("does not fit the points"), "{wrong}: {e}");
+    }
+    assert!(read("hdl64e-roof", &with_rig("hdl64e-roof")).is_ok());
+    let mut csv = String::from("Laser id,Elevation,Azimuth\n");
+    let xt = &sim::sensor::catalogue::PANDAR_XT32;
+    for (i, (e, a)) in xt.elevation_deg.iter().zip(xt.azimuth_offset_deg).enumerate() {
+        csv.push_str(&format!("{},{e},{a}\n", i + 1));
+    }
+    let path = dir.path().join("xt32.csv");
+    std::fs::write(&path, csv).unwrap();
+    let e = read("pandar64-roof", &SensorSetup::new(None, Some(&path)).unwrap()).unwrap_err().to_string();
+    assert!(e.contains("the calibration file's table") && e.contains("at most two echoes per beam"), "{e}");
+}
+
 /// A driver's flat cloud with a ring field (the laser id: the channel's index in the vendor's
 /// table, not in elevation order for most makes), in firing order, read without a rig: the sensor
 /// is named from the rings' elevations, each ring goes to its own row, and the points land in their

@@ -142,21 +142,50 @@ impl SensorSetup {
         if self.recover || self.columns_from_data {
             let given = self.columns_from_data.then_some(&self.table);
             let to = self.vehicle_from_sensor;
-            return match attributes.rings {
-                None => super::recover::order_recovered(points, attributes, given, to, cloud, report),
-                Some(_) => super::recover::order_ring_field(points, attributes, given, to, cloud, report),
-            };
+            match attributes.rings {
+                None => super::recover::order_recovered(points, attributes, given, to, cloud, report)?,
+                Some(_) => super::recover::order_ring_field(points, attributes, given, to, cloud, report)?,
+            }
+        } else {
+            order_cloud_into(
+                points,
+                attributes,
+                &self.table,
+                self.vehicle_from_sensor,
+                PathChoice::Auto,
+                &UnfoldParams::default(),
+                cloud,
+                report,
+            )?;
         }
-        order_cloud_into(
-            points,
-            attributes,
-            &self.table,
-            self.vehicle_from_sensor,
-            PathChoice::Auto,
-            &UnfoldParams::default(),
-            cloud,
-            report,
-        )
+        self.check_fit(report)
+    }
+
+    /// Refuses an ordering where more than half the points fall in a cell an earlier point
+    /// already holds (kept on a further plane, or sharing it as a second echo): a sensor gives at
+    /// most two echoes per beam, so the table (a rig's, a calibration file's) is not this
+    /// sensor's, or the points are not in its frame. Measured on real frames read with wrong
+    /// tables: 58-97 % of their points; with their own: 1-12 %.
+    fn check_fit(&self, report: &OrderingReport) -> Result<()> {
+        let (kept, crowded) = (report.kept(), report.stacked + report.shared);
+        if kept == 0 || 2 * crowded <= kept {
+            return Ok(());
+        }
+        let table = if self.calibrated_lasers.is_some() {
+            "the calibration file's table"
+        } else if self.recover {
+            "the table recovered from the data"
+        } else {
+            "the rig's beam table"
+        };
+        Err(ClassifyError::Ordering(format!(
+            "{table} ({} rows x {} columns) does not fit the points: {crowded} of {kept} ({:.0} %) fall in a cell an \
+             earlier point already holds, and a sensor gives at most two echoes per beam; name this sensor's rig or \
+             calibration file (or neither: the sensor is then recovered from the data), with the points in its frame",
+            report.sensor.as_ref().map_or(self.table.elevations_rad.len(), |s| s.rows),
+            report.sensor.as_ref().map_or(self.table.cols, |s| s.columns),
+            100.0 * crowded as f64 / kept as f64
+        )))
     }
 
     /// Orders one KITTI-layout frame (`x y z intensity` records in the sensor frame, optional
