@@ -183,6 +183,38 @@ fn a_table_that_is_not_the_sensors_is_refused() {
     assert!(e.contains("the calibration file's table") && e.contains("at most two echoes per beam"), "{e}");
 }
 
+/// Our own PLY and LAS files (vehicle-frame points with their rings, returns in grid order) read
+/// with the scan's roof rig: moved into the sensor's frame, every return in its simulated cell;
+/// without a rig the mount is not known, and the file is refused saying so.
+#[test]
+fn our_ply_and_las_files_are_read_with_their_rig_into_their_cells() {
+    let dir = tempfile::tempdir().unwrap();
+    for rig_name in ["hdl64e-roof", "os1-64-roof", "pandar64-roof"] {
+        let (cloud, rig) = scan(rig_name);
+        // Returns in grid order: the i-th return's simulated cell.
+        let truth: Vec<Option<usize>> = (0..cloud.len()).filter(|&i| cloud.has_return(i)).map(Some).collect();
+        let with_rig = SensorSetup::new(Some(&rig), None).unwrap();
+        for (name, bytes) in [
+            ("f.ply", sim::io::ply::encode(&cloud).unwrap().0),
+            ("f.las", sim::io::las::encode(std::path::Path::new("f.las"), &cloud).unwrap().0),
+        ] {
+            let path = dir.path().join(format!("{rig_name}-{name}"));
+            std::fs::write(&path, bytes).unwrap();
+            let recording = classifier::recording::Recording::open(&path, None).unwrap();
+            let mut frames = recording.frames(classifier::recording::Ordering::Ordered(&with_rig)).unwrap();
+            let frame = frames.next_frame().unwrap().unwrap_or_else(|e| panic!("{rig_name} {name}: {e}"));
+            let report = frame.report.cloned().unwrap();
+            assert_eq!((frame.cloud.rows, frame.cloud.cols), (cloud.rows, cloud.cols), "{rig_name} {name}");
+            let right = in_their_cells(&truth, &report, cloud.rows * cloud.cols, cloud.rows * cloud.cols);
+            assert!(right >= FLOOR, "{rig_name} {name}: {right:.5} in their simulated cell");
+            let default = SensorSetup::default();
+            let mut frames = recording.frames(classifier::recording::Ordering::Ordered(&default)).unwrap();
+            let e = frames.next_frame().unwrap().err().expect("refused without a rig").to_string();
+            assert!(e.contains("written by groundtruth in the vehicle frame: give the scan's rig"), "{e}");
+        }
+    }
+}
+
 /// A driver's flat cloud with a ring field (the laser id: the channel's index in the vendor's
 /// table, not in elevation order for most makes), in firing order, read without a rig: the sensor
 /// is named from the rings' elevations, each ring goes to its own row, and the points land in their

@@ -155,10 +155,21 @@ impl FrameReader {
                 Ok(read.read_ms)
             }
             layout @ (InputLayout::Ply | InputLayout::Las) => {
-                let (c, has_ring) = match layout {
-                    InputLayout::Ply => sim::io::ply::read_with_ring(path)?,
-                    _ => (sim::io::las::read(path)?, false),
+                // Our own PLY and LAS files hold vehicle-frame points with their rings.
+                let (mut c, has_ring, ours) = match layout {
+                    InputLayout::Ply => {
+                        let bytes = self.bytes.load(path)?;
+                        let (c, has_ring) = sim::io::ply::read_bytes_with_ring(path, bytes)?;
+                        (c, has_ring, sim::io::ply::written_by_us(bytes))
+                    }
+                    _ => {
+                        let (c, ours) = sim::io::las::read_with_origin(path)?;
+                        (c, ours, ours)
+                    }
                 };
+                if ours {
+                    to_sensor_frame(path, &mut c, setup)?;
+                }
                 let read_ms = t0.elapsed().as_secs_f64() * 1e3;
                 order_flat_cloud(path, &c, has_ring, setup, &mut self.cloud, &mut self.report)?;
                 self.ordered = true;
@@ -354,6 +365,27 @@ pub fn read_as_stored_as(
 
 /// Orders an unorganized cloud `c` read from `path` (its points, intensity, labels, times, and its
 /// rings where `has_ring`) into `cloud`.
+/// Moves the points of `c`, a frame our writer stored in the vehicle frame (PLY, LAS), into the
+/// frame of the rig's sensor, where its beam table orders them; ordering moves them back. Without
+/// a rig the sensor's mount is not known: refused, saying so.
+fn to_sensor_frame(path: &Path, c: &mut OrderedCloud, setup: &SensorSetup) -> Result<(), RecordingError> {
+    if setup.recover || setup.calibrated_lasers.is_some() && setup.vehicle_from_sensor == glam::Affine3A::IDENTITY {
+        return Err(RecordingError::Ordering {
+            what: format!("`{}`", path.display()),
+            error: crate::ClassifyError::Ordering(
+                "written by groundtruth in the vehicle frame: give the scan's rig (`--rig`, the manifest's `rig`) \
+                 so that its points can be moved into the sensor's frame, or classify the scan's PCD or KITTI files"
+                    .into(),
+            ),
+        });
+    }
+    let sensor_from_vehicle = setup.vehicle_from_sensor.inverse();
+    for p in c.point_in_vehicle.iter_mut().filter(|p| p.is_finite()) {
+        *p = sensor_from_vehicle.transform_point3(*p);
+    }
+    Ok(())
+}
+
 fn order_flat_cloud(
     path: &Path,
     c: &OrderedCloud,

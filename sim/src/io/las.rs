@@ -147,6 +147,13 @@ const LAZ_MAX_RATIO: u64 = 64;
 /// exactly 4 (our `instance` field), `range_m` = distance from the origin, `column` = point index.
 /// A malformed file is an error naming it.
 pub fn read(path: &Path) -> Result<OrderedCloud> {
+    Ok(read_with_origin(path)?.0)
+}
+
+/// [`read`], also saying whether the file was written by [`write`] (its header's generating
+/// software is `groundtruth`): then its points are in the vehicle frame and `point_source_id` is
+/// each return's ring.
+pub fn read_with_origin(path: &Path) -> Result<(OrderedCloud, bool)> {
     let file = std::fs::File::open(path).map_err(|e| las_err(path, e.into()))?;
     let file_len = file.metadata().map_err(|e| SimError::io(path, e))?.len();
     read_from(path, std::io::BufReader::new(file), file_len)
@@ -155,7 +162,7 @@ pub fn read(path: &Path) -> Result<OrderedCloud> {
 /// [`read`] on the bytes of a LAS file already in memory (copied once: the `las` crate's reader
 /// owns its input); `path` only names the file in errors.
 pub fn read_bytes(path: &Path, bytes: &[u8]) -> Result<OrderedCloud> {
-    read_from(path, Cursor::new(bytes.to_vec()), bytes.len() as u64)
+    Ok(read_from(path, Cursor::new(bytes.to_vec()), bytes.len() as u64)?.0)
 }
 
 /// Bytes of an extended VLR's header (LAS 1.4 table 10): its data follows.
@@ -213,9 +220,14 @@ fn check_counts_fit<R: Read + Seek>(path: &Path, input: &mut R, file_len: u64) -
 }
 
 /// [`read`] from `input` (`file_len` bytes long); `path` only names the file in errors.
-fn read_from<R: Read + Seek + Send + Sync + 'static>(path: &Path, mut input: R, file_len: u64) -> Result<OrderedCloud> {
+fn read_from<R: Read + Seek + Send + Sync + 'static>(
+    path: &Path,
+    mut input: R,
+    file_len: u64,
+) -> Result<(OrderedCloud, bool)> {
     check_counts_fit(path, &mut input, file_len)?;
     let mut reader = las::Reader::new(input).map_err(|e| las_err(path, e))?;
+    let ours = reader.header().generating_software() == "groundtruth";
     // The header's point count must fit the file: `read_all` reserves what the header declares,
     // so a 300-byte file declaring billions of points would allocate gigabytes (found by the
     // `las` fuzz target). LAZ: up to `LAZ_MAX_RATIO` times smaller than its records.
@@ -254,7 +266,7 @@ fn read_from<R: Read + Seek + Send + Sync + 'static>(path: &Path, mut input: R, 
             c.instance[i] = u32::from_le_bytes([a, b, c4, d]);
         }
     }
-    Ok(c)
+    Ok((c, ours))
 }
 
 #[cfg(test)]

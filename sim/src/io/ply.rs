@@ -19,6 +19,18 @@ use crate::cloud::OrderedCloud;
 use crate::error::{Result, SimError};
 use crate::scene::SemanticClass;
 
+/// The comment our writer puts in the header: the file holds a frame's returns in the vehicle
+/// frame (not a sensor's), with their rings.
+const OUR_COMMENT: &str = "comment groundtruth frame: returns in grid order, vehicle frame";
+
+/// Whether PLY `bytes` were written by [`encode`] (its header comment): vehicle-frame points with
+/// their rings, which a sensor's beam table orders only once moved into that sensor's frame.
+pub fn written_by_us(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(4096)];
+    let end = head.windows(10).position(|w| w == b"end_header").unwrap_or(head.len());
+    head[..end].windows(OUR_COMMENT.len()).any(|w| w == OUR_COMMENT.as_bytes())
+}
+
 /// Bytes per written vertex.
 const VERTEX_BYTES: usize = 4 * 4 + 4 + 8 + 4 + 4 + 1 + 3 * 4;
 
@@ -27,8 +39,7 @@ pub fn encode(cloud: &OrderedCloud) -> Result<(Vec<u8>, usize)> {
     cloud.check_consistent().map_err(|m| SimError::invalid("cloud", m, "every field planes*rows*cols long"))?;
     let n = cloud.returns();
     let header = format!(
-        "ply\nformat binary_little_endian 1.0\ncomment groundtruth frame: returns in grid order, vehicle frame, \
-         metres, seconds\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty float \
+        "ply\nformat binary_little_endian 1.0\n{OUR_COMMENT}, metres, seconds\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty float \
          intensity\nproperty int ring\nproperty double time\nproperty int label\nproperty int instance\n\
          property uchar ground\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n"
     );
